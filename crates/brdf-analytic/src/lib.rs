@@ -1,0 +1,53 @@
+//! Analytic BRDFs of the neural-BRDF comparison, scalar, in f32 and f64, with no tensor library.
+//!
+//! One small interface, [`Brdf`], and one model a file: [`Lambert`], [`RealisticPhong`],
+//! [`TorranceSparrow`], [`Disney`] (isotropic) and [`Fmbrdf`] (Fresnel microfacet BRDF with its
+//! two pretrained helper networks, shipped in this crate). Every model is evaluated in the local
+//! shading frame (normal on +z; `l` to the light, `v` to the viewer, both pointing away from the
+//! surface) and returns f_r in 1/sr as linear RGB, without the cosine factor. Shared physics
+//! (Fresnel terms, the GGX distribution and Smith visibility) lives in [`microfacet`].
+//!
+//! Conventions every model keeps (architecture invariants):
+//! * evaluating never fails, never allocates and never returns NaN or Inf: outside the upper
+//!   hemisphere (n.l <= 0 or n.v <= 0) it returns 0, and parameters are validated or clamped
+//!   when the model is built;
+//! * f32 is the hot path, f64 the reference; tests compare the two.
+//!
+//! A renderer uses the crate alone:
+//!
+//! ```
+//! use brdf_analytic::{Brdf, Disney, DisneyParams};
+//! // A red plastic, evaluated for a light at 30 degrees and the viewer at the normal.
+//! let brdf = Disney::new(DisneyParams { base_color: [0.8, 0.1, 0.1], roughness: 0.3, ..Default::default() });
+//! let (s, c) = 30f32.to_radians().sin_cos();
+//! let f = brdf.eval([s, 0.0, c], [0.0, 0.0, 1.0]);
+//! // Outgoing radiance for a directional light of irradiance E at normal incidence:
+//! let e = 3.0;
+//! let radiance: Vec<f32> = f.iter().map(|fi| fi * e * c).collect();
+//! assert!(radiance.iter().all(|x| x.is_finite() && *x > 0.0));
+//! // Below the horizon the BRDF is zero.
+//! assert_eq!(brdf.eval([s, 0.0, -c], [0.0, 0.0, 1.0]), [0.0; 3]);
+//! ```
+
+// PENDING pub mod albedo;
+mod batch;
+mod brdf;
+// PENDING mod disney;
+// PENDING mod fmbrdf;
+mod lambert;
+pub mod microfacet;
+mod params;
+// PENDING mod phong;
+// PENDING mod torrance_sparrow;
+
+pub use angles::{Real, Vec3};
+pub use batch::eval_batch;
+#[cfg(feature = "rayon")]
+pub use batch::par_eval_batch;
+pub use brdf::{Brdf, Rgb};
+// PENDING pub use disney::{Disney, DisneyParams};
+// PENDING pub use fmbrdf::{Fmbrdf, FmbrdfParams};
+pub use lambert::{Lambert, LambertParams};
+pub use params::ParamError;
+// PENDING pub use phong::{RealisticPhong, RealisticPhongParams};
+// PENDING pub use torrance_sparrow::{TorranceSparrow, TorranceSparrowParams};
