@@ -29,25 +29,25 @@
 //! assert_eq!(brdf.eval([s, 0.0, -c], [0.0, 0.0, 1.0]), [0.0; 3]);
 //! ```
 
-// PENDING pub mod albedo;
+pub mod albedo;
 mod batch;
 mod brdf;
-// PENDING mod disney;
-// PENDING mod fmbrdf;
+mod disney;
+mod fmbrdf;
 mod lambert;
 pub mod microfacet;
 mod params;
-// PENDING mod phong;
-// PENDING mod torrance_sparrow;
+mod phong;
+mod torrance_sparrow;
 
 pub use angles::{Real, Vec3};
 pub use batch::eval_batch;
 #[cfg(feature = "rayon")]
 pub use batch::par_eval_batch;
 pub use brdf::{Brdf, Rgb};
-// PENDING pub use disney::{Disney, DisneyParams};
-// PENDING pub use fmbrdf::{Fmbrdf, FmbrdfParams};
+pub use disney::{Disney, DisneyParams};
+pub use fmbrdf::{Fmbrdf, FmbrdfParams};
 pub use lambert::{Lambert, LambertParams};
 pub use params::ParamError;
-// PENDING pub use phong::{RealisticPhong, RealisticPhongParams};
-// PENDING pub use torrance_sparrow::{TorranceSparrow, TorranceSparrowParams};
+pub use phong::{RealisticPhong, RealisticPhongParams};
+pub use torrance_sparrow::{TorranceSparrow, TorranceSparrowParams};

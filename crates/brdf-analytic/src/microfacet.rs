@@ -20,7 +20,7 @@ pub struct PairGeometry<T> {
     pub nv: T,
     /// n.h.
     pub nh: T,
-    /// l.h = v.h = cos(theta_d).
+    /// l.h = v.h = cos(theta_d), computed as |l + v| / 2 (exact for unit vectors).
     pub lh: T,
     /// sin^2(theta_h), computed from the tangential part of h.
     pub sin2_h: T,
@@ -38,9 +38,10 @@ impl<T: Real> PairGeometry<T> {
         let txy = a[0] * a[0] + a[1] * a[1];
         let len2 = txy + a[2] * a[2];
         // l.z, v.z > 0 implies a.z > 0, hence len2 > 0 (barring underflow: handled below).
-        let inv_len = if len2 > zero { len2.sqrt().recip() } else { zero };
-        let nh = (a[2] * inv_len).min(T::one());
-        let lh = ((l[0] * a[0] + l[1] * a[1] + l[2] * a[2]) * inv_len).max(zero).min(T::one());
+        let len = len2.sqrt();
+        let nh = if len > zero { (a[2] / len).min(T::one()) } else { T::one() };
+        // For unit l, v: l.h = (1 + l.v) / |l + v| = |l + v| / 2, which is symmetric in l and v.
+        let lh = (T::lit(0.5) * len).min(T::one());
         let sin2_h = if len2 > zero { txy / len2 } else { zero };
         Some(Self { nl: l[2].min(T::one()), nv: v[2].min(T::one()), nh, lh, sin2_h })
     }
