@@ -1,9 +1,14 @@
 //! `cargo xtask`: the orchestration CLI of the neural-BRDF comparison.
 //!
 //! Every user-facing job of the workspace is a subcommand here; run `cargo xtask --help`.
+//! The paper's full pipeline (`reproduce-tables`) lands with the training and evaluation issues;
+//! until then the main job is `analytic-report`, which characterises the analytic BRDF library.
+
+mod analytic_report;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
+use std::path::PathBuf;
 
 /// Orchestration CLI of the neural-BRDF comparison workspace.
 #[derive(Parser)]
@@ -15,12 +20,36 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Print the workspace's crates in layering order.
+    /// Characterise every analytic BRDF at its default parameters: directional albedo against
+    /// incidence angle (Monte Carlo, with error bars), reciprocity error, evaluation speed.
+    AnalyticReport {
+        /// Monte Carlo samples per albedo estimate.
+        #[arg(long, default_value_t = 200_000)]
+        samples: usize,
+        /// Random direction pairs for the reciprocity error and the speed measurement.
+        #[arg(long, default_value_t = 1_000_000)]
+        pairs: usize,
+        /// Seed of every random number (the report is deterministic for a seed, speed aside).
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Where to write the Markdown report (atomically).
+        #[arg(long, default_value = "out/analytic-report.md")]
+        out: PathBuf,
+    },
+    /// Print the workspace's crates in layering order (bottom first).
     Layers,
 }
 
 fn main() -> Result<()> {
     match Cli::parse().command {
+        Command::AnalyticReport { samples, pairs, seed, out } => {
+            anyhow::ensure!(samples >= 2, "--samples must be at least 2 (got {samples})");
+            anyhow::ensure!(pairs >= 1, "--pairs must be at least 1 (got {pairs})");
+            let md = analytic_report::report(&analytic_report::Options { samples, pairs, seed });
+            print!("{md}");
+            analytic_report::write_atomic(&out, &md)?;
+            eprintln!("report written to {}", out.display());
+        }
         Command::Layers => {
             for c in LAYERS {
                 println!("{c}");

@@ -194,13 +194,13 @@ impl<T: Real> Brdf<T> for Disney<T> {
         }
         let a = self.alpha;
         let spec =
-            ggx_d(g.sin2_h, a) * smith_ggx_visibility(g.nl, a) * smith_ggx_visibility(g.nv, a);
+            ggx_d(g.sin2_h, a) * (smith_ggx_visibility(g.nl, a) * smith_ggx_visibility(g.nv, a));
         let clearcoat = if self.cc_scale != T::zero() {
             // GTR1 / (pi ln a^2) folded into cc_scale; 1 + (a^2 - 1) cos^2 = sin^2 + a^2 cos^2.
             let dr = self.cc_scale / (g.sin2_h + self.cc_a2 * (one - g.sin2_h));
             let q = T::lit(0.25);
             let fr = T::lit(0.04) + T::lit(0.96) * fh;
-            dr * fr * smith_ggx_visibility(g.nl, q) * smith_ggx_visibility(g.nv, q)
+            dr * fr * (smith_ggx_visibility(g.nl, q) * smith_ggx_visibility(g.nv, q))
         } else {
             T::zero()
         };

@@ -83,7 +83,9 @@ impl<T: Real> Brdf<T> for TorranceSparrow<T> {
     fn eval(&self, l: Vec3<T>, v: Vec3<T>) -> Rgb<T> {
         let Some(g) = PairGeometry::of(l, v) else { return [T::zero(); 3] };
         let a = self.alpha;
-        let dg = ggx_d(g.sin2_h, a) * smith_ggx_visibility(g.nl, a) * smith_ggx_visibility(g.nv, a);
+        // The visibility product first: commutative, so f(l, v) and f(v, l) agree bit for bit.
+        let dg =
+            ggx_d(g.sin2_h, a) * (smith_ggx_visibility(g.nl, a) * smith_ggx_visibility(g.nv, a));
         let w = schlick_weight(g.lh);
         let f0 = self.params.f0;
         [0, 1, 2].map(|c| {
