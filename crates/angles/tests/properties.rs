@@ -138,7 +138,7 @@ fn degenerate_configurations_are_finite() {
 
 #[test]
 fn world_frame_matches_local_frame_for_any_normal() {
-    let n = angles::vec3::normalize_or_zero([0.3, -0.5, 0.8]);
+    let n = angles::vec3::normalize_or_zero([0.3_f64, -0.5, 0.8]);
     let f = angles::Frame::from_normal(n);
     let (l_loc, v_loc) = (spherical(0.7, 0.2), spherical(0.3, 2.9));
     let (l, v) = (f.to_world(l_loc), f.to_world(v_loc));
