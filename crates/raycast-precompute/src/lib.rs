@@ -15,6 +15,7 @@
 //!   back-facing lights.
 //! * [`visibility`]: the (pixel, light) bitsets.
 //! * [`cache`]: the content-keyed, checksummed on-disk cache.
+//! * [`scenes`]: standard orbit views with light domes, for benchmarks and figures.
 //!
 //! Conventions: directions are unit world-space vectors; light directions point from the
 //! surface towards the light; view directions from the surface towards the camera.
@@ -41,6 +42,7 @@ pub mod cache;
 pub mod camera;
 pub mod error;
 pub mod precompute;
+pub mod scenes;
 pub mod tracer;
 pub mod visibility;
 
@@ -50,6 +52,7 @@ pub use camera::{Camera, intrinsics, mat3_from_rows};
 pub use error::{Error, Result};
 pub use precompute::{
     PrecomputeSettings, ScenePrecompute, ShadowBias, TraceStats, View, ViewPrecompute, precompute,
+    precompute_with_tracer,
 };
 pub use tracer::{Hit, Tracer};
 pub use visibility::{LightState, Visibility};

@@ -169,6 +169,19 @@ pub fn precompute(
     Ok(precompute_with(&tracer, views, &lights, settings))
 }
 
+/// [`precompute`] on an already built [`Tracer`] (to reuse one BVH for several calls).
+///
+/// # Errors
+/// As [`precompute`].
+pub fn precompute_with_tracer(
+    tracer: &Tracer,
+    views: &[View],
+    settings: &PrecomputeSettings,
+) -> Result<ScenePrecompute> {
+    let lights = validate_views(views)?;
+    Ok(precompute_with(tracer, views, &lights, settings))
+}
+
 /// The precompute on a built tracer with validated, unit lights.
 pub(crate) fn precompute_with(
     tracer: &Tracer,
