@@ -72,23 +72,22 @@ pub fn directional_albedo<T: Real, B: Brdf<T> + ?Sized>(
     seed: u64,
 ) -> AlbedoEstimate {
     let mut rng = SplitMix64::new(seed);
-    let mut sum = [0.0_f64; 3];
-    let mut sum2 = [0.0_f64; 3];
-    for _ in 0..samples {
+    // Welford's running mean and sum of squared deviations: no cancellation for near-constant
+    // integrands (a Lambertian BRDF gives a standard error of exactly 0).
+    let mut mean = [0.0_f64; 3];
+    let mut m2 = [0.0_f64; 3];
+    for k in 0..samples {
         let v = cosine_sample(rng.next_f64(), rng.next_f64());
         let f = brdf.eval(l, v.map(T::lit));
         for c in 0..3 {
             let x = std::f64::consts::PI * f[c].to_f64_exact();
-            sum[c] += x;
-            sum2[c] += x * x;
+            let delta = x - mean[c];
+            mean[c] += delta / (k + 1) as f64;
+            m2[c] += delta * (x - mean[c]);
         }
     }
     let n = samples.max(1) as f64;
-    let mean = sum.map(|s| s / n);
-    let std_error = [0, 1, 2].map(|c| {
-        let var = (sum2[c] / n - mean[c] * mean[c]).max(0.0) * n / (n - 1.0).max(1.0);
-        (var / n).sqrt()
-    });
+    let std_error = m2.map(|m| (m.max(0.0) / (n - 1.0).max(1.0) / n).sqrt());
     AlbedoEstimate { mean, std_error, samples }
 }
 
