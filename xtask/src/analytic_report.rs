@@ -27,6 +27,7 @@ fn models() -> Vec<Box<dyn Brdf<f64>>> {
         Box::new(RealisticPhong::new(RealisticPhongParams::default())),
         Box::new(TorranceSparrow::new(TorranceSparrowParams::default())),
         Box::new(Disney::new(DisneyParams::default())),
+        Box::new(Fmbrdf::new(FmbrdfParams::default())),
     ]
 }
 
@@ -49,7 +50,9 @@ pub fn report(opts: &Options) -> String {
         rule.push_str(" --- |");
     }
     let _ = writeln!(md, "{header}\n{rule}");
-    for m in models() {
+    let all = models();
+    for (k, m) in all.iter().enumerate() {
+        eprintln!("[{}/{}] directional albedo of {}", k + 1, all.len(), m.name());
         let mut row = format!("| {} |", m.name());
         for (i, t) in THETAS_DEG.iter().enumerate() {
             let (s, c) = t.to_radians().sin_cos();
@@ -83,8 +86,10 @@ pub fn report(opts: &Options) -> String {
         Box::new(RealisticPhong::new(RealisticPhongParams::default())),
         Box::new(TorranceSparrow::new(TorranceSparrowParams::default())),
         Box::new(Disney::new(DisneyParams::default())),
+        Box::new(Fmbrdf::new(FmbrdfParams::default())),
     ];
-    for (m, m32) in models().iter().zip(&models32) {
+    for (k, (m, m32)) in all.iter().zip(&models32).enumerate() {
+        eprintln!("[{}/{}] reciprocity and speed of {}", k + 1, all.len(), m.name());
         let (mut num, mut den) = (0.0, 0.0);
         for (l, v) in &pairs {
             let (a, b) = (m.eval(*l, *v), m.eval(*v, *l));

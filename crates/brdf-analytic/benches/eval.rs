@@ -60,6 +60,21 @@ fn bench_concrete<B: Brdf<f32>>(
     g.finish();
 }
 
+fn bench_fmbrdf(c: &mut Criterion, l: &[[f32; 3]], v: &[[f32; 3]]) {
+    let m = Fmbrdf::new(FmbrdfParams::default());
+    let mut out = vec![[0.0_f32; 3]; l.len()];
+    let mut g = c.benchmark_group("brdf-eval-f32");
+    g.throughput(Throughput::Elements(l.len() as u64));
+    g.sample_size(10);
+    g.bench_function("fmbrdf/parallel", |b| {
+        b.iter(|| par_eval_batch(black_box(&m), black_box(l), black_box(v), &mut out))
+    });
+    g.bench_function("fmbrdf/single-thread", |b| {
+        b.iter(|| eval_batch(black_box(&m), black_box(l), black_box(v), &mut out))
+    });
+    g.finish();
+}
+
 fn bench(c: &mut Criterion) {
     let (l, v) = (directions(1), directions(2));
     bench_concrete(c, "lambert", &Lambert::new(LambertParams::default()), &l, &v);
@@ -78,6 +93,9 @@ fn bench(c: &mut Criterion) {
         &v,
     );
     bench_concrete(c, "disney-default", &Disney::new(DisneyParams::default()), &l, &v);
+    // FMBRDF evaluates two small MLPs per call: a smaller batch keeps the bench short.
+    let k = N / 64;
+    bench_fmbrdf(c, &l[..k], &v[..k]);
     let (_, all) = models().into_iter().nth(4).unwrap();
     let mut out = vec![[0.0_f32; 3]; N];
     let mut g = c.benchmark_group("brdf-eval-f32");

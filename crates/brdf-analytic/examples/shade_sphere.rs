@@ -49,6 +49,7 @@ fn main() -> std::io::Result<()> {
         ("realistic-phong", Box::new(RealisticPhong::new(RealisticPhongParams::default()))),
         ("torrance-sparrow", Box::new(TorranceSparrow::new(TorranceSparrowParams::default()))),
         ("disney", Box::new(Disney::new(DisneyParams::default()))),
+        ("fmbrdf", Box::new(Fmbrdf::new(FmbrdfParams::default()))),
     ];
     for (name, m) in &models {
         let img = render(m.as_ref(), size, light);
