@@ -49,7 +49,8 @@ impl std::fmt::Debug for Tracer {
 }
 
 impl Tracer {
-    /// Builds the BVH (obvhs PLOC builder, "medium" preset with spatial pre-splits).
+    /// Builds the BVH (obvhs PLOC builder, "slow" preset: spatial pre-splits, more reinsertion;
+    /// 0.06-0.17 s for 70k-124k triangles, and 10-40 % faster traversal than "medium").
     pub fn new(mesh: &TriMesh) -> Self {
         let start = Instant::now();
         let tris: Vec<Triangle> = (0..mesh.triangle_count())
@@ -59,7 +60,7 @@ impl Tracer {
             })
             .collect();
         let mut core_time = Duration::ZERO;
-        let bvh = build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut core_time);
+        let bvh = build_cwbvh_from_tris(&tris, BvhBuildParams::slow_build(), &mut core_time);
         let leaf_tris =
             bvh.primitive_indices.iter().map(|&i| RtTriangle::from(&tris[i as usize])).collect();
         Tracer { bvh, leaf_tris, mesh: mesh.clone(), build_time: start.elapsed() }
