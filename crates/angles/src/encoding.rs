@@ -77,7 +77,10 @@ impl PositionalEncoding {
     /// If the slice lengths do not match `input_dim`.
     pub fn encode_batch<T: Real>(&self, input: &[T], input_dim: usize, out: &mut [T]) {
         let od = self.output_len(input_dim);
-        assert!(input_dim > 0 && input.len().is_multiple_of(input_dim), "encode_batch: input shape");
+        assert!(
+            input_dim > 0 && input.len().is_multiple_of(input_dim),
+            "encode_batch: input shape"
+        );
         assert_eq!(out.len(), input.len() / input_dim * od, "encode_batch: output length");
         for (row, o) in input.chunks_exact(input_dim).zip(out.chunks_exact_mut(od)) {
             self.encode_into(row, o);
