@@ -1,7 +1,9 @@
 //! Prints the ray-casting figures of the geometry note: BVH build time, primary plus shadow rays
 //! per second for stanford-bunny and ogre (512 x 512, 42 lights, 4 orbit views), and the speed
 //! ratio against the brute-force reference (both on all rayon threads, brute force on a sample
-//! of the same camera rays).
+//! of the same camera rays). The packet path (the default) and the one-ray-at-a-time reference
+//! path are timed alternately in the same run (A/B under the same load) and must agree bit for
+//! bit.
 //!
 //! `cargo run --release -p raycast-precompute --example raycast_figures`
 
@@ -10,7 +12,10 @@ use std::time::Instant;
 
 use mesh_encoding::{LoadOptions, load_mesh};
 use raycast_precompute::scenes::orbit_views;
-use raycast_precompute::{BruteForce, PrecomputeSettings, Tracer, precompute_with_tracer};
+use raycast_precompute::{
+    BruteForce, PrecomputeSettings, Tracer, Traversal, precompute_with_tracer,
+    precompute_with_traversal,
+};
 use rayon::prelude::*;
 
 fn main() {
@@ -33,12 +38,19 @@ fn main() {
         let views = orbit_views(4, 42, 512, 2.6, 45.0, 11);
         let settings = PrecomputeSettings::default();
         let _warm = precompute_with_tracer(&tracer, &views[..1], &settings).unwrap();
+        // A/B: the one-by-one reference (A) and the packets (B), alternated, best of 3 each.
         let mut best = f64::INFINITY;
+        let mut best_simple = f64::INFINITY;
         let mut stats = Default::default();
         for _ in 0..3 {
             let start = Instant::now();
+            let simple =
+                precompute_with_traversal(&tracer, &views, &settings, Traversal::OneByOne).unwrap();
+            best_simple = best_simple.min(start.elapsed().as_secs_f64());
+            let start = Instant::now();
             let scene = precompute_with_tracer(&tracer, &views, &settings).unwrap();
             best = best.min(start.elapsed().as_secs_f64());
+            assert_eq!(scene, simple, "packet and one-by-one paths disagree");
             stats = scene.stats;
         }
         let rays = (stats.primary_rays + stats.shadow_rays) as f64;
@@ -66,6 +78,13 @@ fn main() {
             .sum();
         let bvh_sample_rate = sample.len() as f64 / start.elapsed().as_secs_f64();
 
+        println!(
+            "{name}: one-by-one {:.2} M rays/s, packets {:.2} M rays/s: {:.2}x (same process, \
+             alternated, best of 3, results bit-identical)",
+            rays / best_simple / 1e6,
+            rays / best / 1e6,
+            best_simple / best
+        );
         println!(
             "{name}: {} triangles; BVH build {:.3}-{:.3} s; {} primary + {} shadow rays \
              ({} back-facing skipped) in {:.3} s = {:.2} M rays/s; brute force {:.0} rays/s on \

@@ -25,6 +25,7 @@ use crate::precompute::{
     PrecomputeSettings, ScenePrecompute, ShadowBias, TraceStats, View, ViewPrecompute,
     precompute_with, validate_views,
 };
+use crate::shadows::Traversal;
 use crate::tracer::Tracer;
 use crate::visibility::Visibility;
 
@@ -120,7 +121,7 @@ pub fn precompute_cached(
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => CacheOutcome::Miss,
         Err(e) => CacheOutcome::Rebuilt { reason: format!("unreadable: {e}") },
     };
-    let scene = precompute_with(&Tracer::new(mesh), views, &lights, settings);
+    let scene = precompute_with(&Tracer::new(mesh), views, &lights, settings, Traversal::default());
     write_atomic(&path, &encode(&scene, key))?;
     Ok((scene, outcome))
 }

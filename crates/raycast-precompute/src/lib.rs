@@ -10,9 +10,11 @@
 //! * [`camera`]: OpenCV pinhole cameras (x right, y down, z forward; x_c = R x_w + t; pixel
 //!   centres at +0.5) and a look-at constructor.
 //! * [`tracer`]: the obvhs CWBVH, closest hit and any hit.
+//! * [`packet`]: any-hit traversal of up to 64 shadow rays sharing one direction at once.
 //! * [`brute_force`]: the f64 all-triangles reference the tracer is tested against.
 //! * [`precompute`]: primary and shadow rays for a scene, skipping background pixels and
 //!   back-facing lights.
+//! * [`shadows`]: the shadow-ray stage, in 8 x 8-tile packets per light or one ray at a time.
 //! * [`visibility`]: the (pixel, light) bitsets.
 //! * [`cache`]: the content-keyed, checksummed on-disk cache.
 //! * [`scenes`]: standard orbit views with light domes, for benchmarks and figures.
@@ -41,8 +43,10 @@ pub mod brute_force;
 pub mod cache;
 pub mod camera;
 pub mod error;
+pub mod packet;
 pub mod precompute;
 pub mod scenes;
+pub mod shadows;
 pub mod tracer;
 pub mod visibility;
 
@@ -52,7 +56,9 @@ pub use camera::{Camera, intrinsics, mat3_from_rows};
 pub use error::{Error, Result};
 pub use precompute::{
     PrecomputeSettings, ScenePrecompute, ShadowBias, TraceStats, View, ViewPrecompute, precompute,
-    precompute_with_tracer,
+    precompute_with_tracer, precompute_with_traversal,
 };
+pub use shadows::Traversal;
+pub use packet::PACKET_SIZE;
 pub use tracer::{Hit, Tracer};
 pub use visibility::{LightState, Visibility};

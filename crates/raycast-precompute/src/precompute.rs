@@ -19,6 +19,7 @@ use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::tracer::Tracer;
 use crate::visibility::Visibility;
+use crate::shadows::{Traversal, trace_shadows};
 
 /// One view of a scene: a camera, its light directions and an optional foreground mask.
 #[derive(Debug, Clone, PartialEq)]
@@ -166,7 +167,7 @@ pub fn precompute(
 ) -> Result<ScenePrecompute> {
     let lights = validate_views(views)?;
     let tracer = Tracer::new(mesh);
-    Ok(precompute_with(&tracer, views, &lights, settings))
+    Ok(precompute_with(&tracer, views, &lights, settings, Traversal::default()))
 }
 
 /// [`precompute`] on an already built [`Tracer`] (to reuse one BVH for several calls).
@@ -178,8 +179,22 @@ pub fn precompute_with_tracer(
     views: &[View],
     settings: &PrecomputeSettings,
 ) -> Result<ScenePrecompute> {
+    precompute_with_traversal(tracer, views, settings, Traversal::default())
+}
+
+/// [`precompute_with_tracer`] with a chosen shadow-ray [`Traversal`]; every choice gives the same
+/// (bit-identical) result, [`Traversal::OneByOne`] is the simple reference path.
+///
+/// # Errors
+/// As [`precompute`].
+pub fn precompute_with_traversal(
+    tracer: &Tracer,
+    views: &[View],
+    settings: &PrecomputeSettings,
+    traversal: Traversal,
+) -> Result<ScenePrecompute> {
     let lights = validate_views(views)?;
-    Ok(precompute_with(tracer, views, &lights, settings))
+    Ok(precompute_with(tracer, views, &lights, settings, traversal))
 }
 
 /// The precompute on a built tracer with validated, unit lights.
@@ -188,6 +203,7 @@ pub(crate) fn precompute_with(
     views: &[View],
     lights: &[Vec<Vec3>],
     settings: &PrecomputeSettings,
+    traversal: Traversal,
 ) -> ScenePrecompute {
     let mesh = tracer.mesh();
     let vertex_normals = mesh.vertex_normals(settings.normal_weighting);
@@ -198,7 +214,7 @@ pub(crate) fn precompute_with(
     );
     let mut out = ScenePrecompute { shadow_bias: bias, ..Default::default() };
     for (view, lights) in views.iter().zip(lights) {
-        let (vp, stats) = trace_view(tracer, &vertex_normals, view, lights, bias);
+        let (vp, stats) = trace_view(tracer, &vertex_normals, view, lights, bias, traversal);
         out.stats.primary_rays += stats.primary_rays;
         out.stats.shadow_rays += stats.shadow_rays;
         out.stats.skipped_back_facing += stats.skipped_back_facing;
@@ -227,6 +243,7 @@ fn trace_view(
     view: &View,
     lights: &[Vec3],
     bias: f32,
+    traversal: Traversal,
 ) -> (ViewPrecompute, TraceStats) {
     let cam = &view.camera;
     let mesh = tracer.mesh();
@@ -258,32 +275,11 @@ fn trace_view(
         })
         .collect();
 
-    let mut visibility = Visibility::new(hits.len(), lights.len());
-    let wpp = Visibility::words_for(lights.len()).max(1);
-    let (mut shadow_rays, mut skipped) = (0u64, 0u64);
-    if !lights.is_empty() {
-        (shadow_rays, skipped) = visibility
-            .lit
-            .par_chunks_mut(wpp)
-            .zip(visibility.front.par_chunks_mut(wpp))
-            .zip(hits.par_iter())
-            .map(|((lit, front), h)| {
-                let (mut traced, mut skip) = (0u64, 0u64);
-                for (l, dir) in lights.iter().enumerate() {
-                    if h.normal.dot(*dir) <= 0.0 {
-                        skip += 1;
-                        continue;
-                    }
-                    traced += 1;
-                    front[l / 64] |= 1 << (l % 64);
-                    if !tracer.occluded(h.shadow_origin, *dir, f32::INFINITY) {
-                        lit[l / 64] |= 1 << (l % 64);
-                    }
-                }
-                (traced, skip)
-            })
-            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-    }
+    let origins: Vec<Vec3> = hits.iter().map(|h| h.shadow_origin).collect();
+    let normals: Vec<Vec3> = hits.iter().map(|h| h.normal).collect();
+    let pixels: Vec<u32> = hits.iter().map(|h| h.pixel).collect();
+    let (visibility, shadow_rays, skipped) =
+        trace_shadows(tracer, &origins, &normals, &pixels, cam.width, lights, traversal);
     let stats = TraceStats {
         primary_rays: candidates.len() as u64,
         shadow_rays,
@@ -292,11 +288,11 @@ fn trace_view(
     let vp = ViewPrecompute {
         width: cam.width,
         height: cam.height,
-        pixels: hits.iter().map(|h| h.pixel).collect(),
+        pixels,
         triangles: hits.iter().map(|h| h.triangle).collect(),
         barycentrics: hits.iter().map(|h| h.barycentrics).collect(),
         positions: hits.iter().map(|h| h.position).collect(),
-        normals: hits.iter().map(|h| h.normal).collect(),
+        normals,
         view_dirs: hits.iter().map(|h| h.view_dir).collect(),
         lights: lights.to_vec(),
         visibility,
