@@ -102,11 +102,34 @@ pub enum Error {
         /// The fault.
         fault: MeshFault,
     },
+    /// The Laplace-Beltrami encoding failed: unusable matrices, a failed factorisation or an
+    /// eigen-solve that did not converge.
+    #[error("LBO encoding: {message}")]
+    Lbo {
+        /// What went wrong.
+        message: String,
+    },
+    /// An LBO eigenpair cache file could not be written (a corrupted one is recomputed, not an
+    /// error).
+    #[error("{}: LBO eigenpair cache: {message}", path.display())]
+    LboCache {
+        /// The cache file or directory.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
 }
 
 impl Error {
     /// An [`Error::Invalid`] for a mesh built in memory.
     pub fn in_memory(fault: MeshFault) -> Self {
         Error::Invalid { path: PathBuf::from("<memory>"), fault }
+    }
+}
+
+impl Error {
+    /// An [`Error::Lbo`] with a message.
+    pub fn lbo(message: impl Into<String>) -> Self {
+        Error::Lbo { message: message.into() }
     }
 }

@@ -7,6 +7,9 @@
 //! * [`mesh`]: the indexed triangle mesh [`TriMesh`], loading ([`load_mesh`]: OBJ via tobj, PLY
 //!   via ply-rs-bw, glTF/GLB via gltf), cleanup with a report, topology statistics, angle- or
 //!   area-weighted vertex normals and normalisation into the unit sphere.
+//! * [`lbo`]: the Laplace-Beltrami eigenfunction encoding: cotangent/mixed-Voronoi assembly
+//!   ([`LboMatrices`]), a shift-invert block Lanczos eigensolver on faer's sparse Cholesky
+//!   ([`smallest_eigenpairs`]), an eigenpair cache and the per-point encoding ([`LboEncoding`]).
 //! * [`error`]: the crate's [`Error`] (every message names the file and the fault) and
 //!   [`Result`].
 //!
@@ -21,10 +24,15 @@
 //! ```
 
 pub mod error;
+pub mod lbo;
 pub mod mesh;
 
 pub use error::{Error, MeshFault, Result};
 pub use glam;
+pub use lbo::{
+    EigenSettings, Eigenpairs, LboEncoding, LboEncodingConfig, LboMatrices, cached_eigenpairs,
+    smallest_eigenpairs,
+};
 pub use mesh::{
     CleanupReport, LoadOptions, LoadReport, LoadedMesh, MeshFormat, NormalWeighting, Similarity,
     Topology, TriMesh, interpolate_normal, load_mesh,

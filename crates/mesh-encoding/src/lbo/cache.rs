@@ -1,0 +1,221 @@
+//! On-disk cache of eigenpairs, one file per mesh and solve, under a content key.
+//!
+//! * **Key**: xxh3-128 of a format version, the vertex positions and triangles (as f64 / u32
+//!   little-endian bytes), `k` and every [`EigenSettings`] field. Any change to the mesh or the
+//!   solve gives a new file name `lbo-<key as 32 hex digits>.bin`.
+//! * **File** (little-endian): magic `NBLBOEIG`, format version `u32`, key `u128`, `n u64`,
+//!   `k u64`, `k` eigenvalues `f64`, the `n x k` eigenvectors column by column `f64`, then the
+//!   xxh3-64 checksum `u64` of everything before it.
+//! * Written to a temporary file in the same directory and renamed into place, so a reader
+//!   never sees a half-written file. A file with a wrong magic, version, key, size or checksum
+//!   is reported as [`CacheOutcome::Recomputed`] and overwritten.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use faer::Mat;
+use xxhash_rust::xxh3::{xxh3_64, xxh3_128};
+
+use super::assembly::LboMatrices;
+use super::eigen::{EigenSettings, Eigenpairs, smallest_eigenpairs};
+use crate::error::{Error, Result};
+
+const MAGIC: &[u8; 8] = b"NBLBOEIG";
+/// Bumped whenever the file layout or the meaning of the cached numbers changes.
+const FORMAT_VERSION: u32 = 1;
+const HEADER_LEN: usize = 8 + 4 + 16 + 8 + 8;
+
+/// What [`cached_eigenpairs`] did.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum CacheOutcome {
+    /// A valid cache file was loaded.
+    Loaded,
+    /// No cache file existed; the pairs were computed and written.
+    Computed,
+    /// A cache file existed but was unusable (the reason is given); it was recomputed and
+    /// overwritten.
+    Recomputed(String),
+}
+
+/// The content key of a mesh, `k` and the solver settings.
+pub fn cache_key(
+    vertices: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    k: usize,
+    settings: &EigenSettings,
+) -> u128 {
+    let mut bytes = Vec::with_capacity(64 + vertices.len() * 24 + triangles.len() * 12);
+    bytes.extend_from_slice(MAGIC);
+    bytes.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    bytes.extend_from_slice(&(vertices.len() as u64).to_le_bytes());
+    for c in vertices.iter().flatten() {
+        bytes.extend_from_slice(&c.to_le_bytes());
+    }
+    bytes.extend_from_slice(&(triangles.len() as u64).to_le_bytes());
+    for i in triangles.iter().flatten() {
+        bytes.extend_from_slice(&i.to_le_bytes());
+    }
+    bytes.extend_from_slice(&(k as u64).to_le_bytes());
+    let EigenSettings { block_size, tolerance, max_basis_factor, shift_factor, seed } = *settings;
+    bytes.extend_from_slice(&(block_size as u64).to_le_bytes());
+    for x in [tolerance, max_basis_factor, shift_factor] {
+        bytes.extend_from_slice(&x.to_le_bytes());
+    }
+    bytes.extend_from_slice(&seed.to_le_bytes());
+    xxh3_128(&bytes)
+}
+
+/// The cache file for a key in `dir`.
+pub fn cache_path(dir: &Path, key: u128) -> PathBuf {
+    dir.join(format!("lbo-{key:032x}.bin"))
+}
+
+/// The `k` smallest eigenpairs of the mesh, from the cache in `dir` when a valid file is there,
+/// otherwise computed with [`smallest_eigenpairs`] and written to it.
+///
+/// # Errors
+/// Assembly and solver errors, and [`Error::LboCache`] when the cache file cannot be written.
+pub fn cached_eigenpairs(
+    vertices: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    k: usize,
+    settings: &EigenSettings,
+    dir: &Path,
+) -> Result<(Eigenpairs, CacheOutcome)> {
+    let key = cache_key(vertices, triangles, k, settings);
+    let path = cache_path(dir, key);
+    let outcome = match std::fs::read(&path) {
+        Ok(bytes) => match decode(&bytes, key, vertices.len(), k) {
+            Ok(pairs) => return Ok((pairs, CacheOutcome::Loaded)),
+            Err(reason) => CacheOutcome::Recomputed(reason),
+        },
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => CacheOutcome::Computed,
+        Err(e) => CacheOutcome::Recomputed(format!("unreadable: {e}")),
+    };
+    let matrices = LboMatrices::assemble(vertices, triangles)?;
+    let (pairs, _report) = smallest_eigenpairs(&matrices, k, settings)?;
+    write_atomic(&path, &encode(&pairs, key))?;
+    Ok((pairs, outcome))
+}
+
+/// Serialises pairs into the cache layout.
+fn encode(pairs: &Eigenpairs, key: u128) -> Vec<u8> {
+    let (n, k) = (pairs.vertex_count(), pairs.len());
+    let mut out = Vec::with_capacity(HEADER_LEN + 8 * (k + n * k) + 8);
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    out.extend_from_slice(&key.to_le_bytes());
+    out.extend_from_slice(&(n as u64).to_le_bytes());
+    out.extend_from_slice(&(k as u64).to_le_bytes());
+    for v in &pairs.values {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    for j in 0..k {
+        for x in pairs.vectors.col_as_slice(j) {
+            out.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    let checksum = xxh3_64(&out);
+    out.extend_from_slice(&checksum.to_le_bytes());
+    out
+}
+
+/// Parses and checks a cache file; the error says why it is unusable.
+fn decode(bytes: &[u8], key: u128, n: usize, k: usize) -> std::result::Result<Eigenpairs, String> {
+    let expected_len = HEADER_LEN + 8 * (k + n * k) + 8;
+    if bytes.len() < HEADER_LEN || &bytes[..8] != MAGIC {
+        return Err("not an LBO cache file (bad magic)".into());
+    }
+    let u64_at = |o: usize| u64::from_le_bytes(bytes[o..o + 8].try_into().expect("8 bytes"));
+    let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
+    if version != FORMAT_VERSION {
+        return Err(format!("format version {version}, expected {FORMAT_VERSION}"));
+    }
+    let file_key = u128::from_le_bytes(bytes[12..28].try_into().expect("16 bytes"));
+    if file_key != key {
+        return Err("content key mismatch".into());
+    }
+    let (file_n, file_k) = (u64_at(28), u64_at(36));
+    if file_n != n as u64 || file_k != k as u64 {
+        return Err(format!("sizes {file_n} x {file_k}, expected {n} x {k}"));
+    }
+    if bytes.len() != expected_len {
+        return Err(format!("length {} bytes, expected {expected_len} (truncated?)", bytes.len()));
+    }
+    let body = &bytes[..expected_len - 8];
+    if xxh3_64(body) != u64_at(expected_len - 8) {
+        return Err("checksum mismatch (corrupted)".into());
+    }
+    let f64_at = |o: usize| f64::from_le_bytes(bytes[o..o + 8].try_into().expect("8 bytes"));
+    let values: Vec<f64> = (0..k).map(|i| f64_at(HEADER_LEN + 8 * i)).collect();
+    let base = HEADER_LEN + 8 * k;
+    let vectors = Mat::<f64>::from_fn(n, k, |i, j| f64_at(base + 8 * (j * n + i)));
+    Ok(Eigenpairs { values, vectors })
+}
+
+/// Writes `bytes` to a temporary file next to `path` and renames it into place.
+fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let fail = |message: String| Error::LboCache { path: path.to_owned(), message };
+    let dir = path.parent().unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).map_err(|e| fail(format!("cannot create the directory: {e}")))?;
+    let file_name = path.file_name().and_then(|s| s.to_str()).unwrap_or("lbo.bin");
+    let tmp = dir.join(format!(".{file_name}.tmp-{}", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    result.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        fail(format!("cannot write: {e}"))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pairs() -> Eigenpairs {
+        Eigenpairs {
+            values: vec![0.0, 1.5, 2.25],
+            vectors: Mat::from_fn(4, 3, |i, j| (i * 3 + j) as f64 * 0.1 - 0.4),
+        }
+    }
+
+    #[test]
+    fn round_trip_and_every_kind_of_damage_is_detected() {
+        let p = pairs();
+        let bytes = encode(&p, 42);
+        let back = decode(&bytes, 42, 4, 3).unwrap();
+        assert_eq!(back.values, p.values);
+        assert_eq!(back.vectors, p.vectors);
+        assert!(decode(&bytes, 43, 4, 3).unwrap_err().contains("key"));
+        assert!(decode(&bytes, 42, 5, 3).unwrap_err().contains("sizes"));
+        assert!(decode(&bytes[..bytes.len() - 3], 42, 4, 3).unwrap_err().contains("truncated"));
+        let mut flipped = bytes.clone();
+        flipped[HEADER_LEN + 17] ^= 0x10;
+        assert!(decode(&flipped, 42, 4, 3).unwrap_err().contains("checksum"));
+        let mut magic = bytes.clone();
+        magic[0] = b'X';
+        assert!(decode(&magic, 42, 4, 3).unwrap_err().contains("magic"));
+        let mut version = bytes;
+        version[8] = 99;
+        assert!(decode(&version, 42, 4, 3).unwrap_err().contains("version"));
+    }
+
+    #[test]
+    fn key_depends_on_mesh_k_and_settings() {
+        let v = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let t = [[0, 1, 2]];
+        let s = EigenSettings::default();
+        let key = cache_key(&v, &t, 3, &s);
+        assert_eq!(key, cache_key(&v, &t, 3, &s));
+        assert_ne!(key, cache_key(&v, &t, 2, &s));
+        assert_ne!(key, cache_key(&v, &[[0, 2, 1]], 3, &s));
+        let mut moved = v;
+        moved[2][2] = 1e-9;
+        assert_ne!(key, cache_key(&moved, &t, 3, &s));
+        assert_ne!(key, cache_key(&v, &t, 3, &EigenSettings { tolerance: 1e-7, ..s }));
+    }
+}

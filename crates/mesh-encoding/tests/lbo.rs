@@ -1,0 +1,259 @@
+//! Laplace-Beltrami eigenpairs and encoding: sphere spectrum and its convergence, M-orthonormality,
+//! residuals, agreement with the dense solver, connected components, degenerate triangles, the
+//! cache and the encoding on shared meshes.
+
+mod common;
+
+use mesh_encoding::lbo::{
+    CacheOutcome, EigenSettings, Eigenpairs, LboEncoding, LboEncodingConfig, LboMatrices,
+    cached_eigenpairs, dense_eigenpairs, smallest_eigenpairs,
+};
+use mesh_encoding::{LoadOptions, load_mesh};
+
+/// Unit icosphere: the icosahedron subdivided `level` times, vertices projected to the sphere.
+fn icosphere(level: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut v: Vec<[f64; 3]> = vec![
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ];
+    let mut f: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    let normalize = |p: [f64; 3]| {
+        let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        [p[0] / l, p[1] / l, p[2] / l]
+    };
+    v.iter_mut().for_each(|p| *p = normalize(*p));
+    for _ in 0..level {
+        let mut mid = std::collections::HashMap::new();
+        let mut next = Vec::with_capacity(f.len() * 4);
+        let mut midpoint = |a: u32, b: u32, v: &mut Vec<[f64; 3]>| {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                let (p, q) = (v[a as usize], v[b as usize]);
+                v.push(normalize([p[0] + q[0], p[1] + q[1], p[2] + q[2]]));
+                (v.len() - 1) as u32
+            })
+        };
+        for &[a, b, c] in &f {
+            let ab = midpoint(a, b, &mut v);
+            let bc = midpoint(b, c, &mut v);
+            let ca = midpoint(c, a, &mut v);
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        f = next;
+    }
+    (v, f)
+}
+
+fn small_settings() -> EigenSettings {
+    EigenSettings { block_size: 8, ..Default::default() }
+}
+
+fn solve(v: &[[f64; 3]], f: &[[u32; 3]], k: usize) -> (LboMatrices, Eigenpairs) {
+    let m = LboMatrices::assemble(v, f).unwrap();
+    let (pairs, report) = smallest_eigenpairs(&m, k, &small_settings()).unwrap();
+    assert!(!report.dense, "the test should exercise the sparse solver");
+    (m, pairs)
+}
+
+/// Largest relative deviation from l(l+1) over the first `lmax + 1` bands.
+fn sphere_error(values: &[f64], lmax: usize) -> f64 {
+    let mut worst: f64 = 0.0;
+    for l in 1..=lmax {
+        let exact = (l * (l + 1)) as f64;
+        for &x in &values[l * l..(l + 1) * (l + 1)] {
+            worst = worst.max((x - exact).abs() / exact);
+        }
+    }
+    worst
+}
+
+#[test]
+fn sphere_spectrum_converges_to_l_l_plus_1_with_multiplicity() {
+    let lmax = 4;
+    let k = (lmax + 1) * (lmax + 1);
+    let mut errors = Vec::new();
+    for level in [3, 4] {
+        let (v, f) = icosphere(level);
+        let (m, pairs) = solve(&v, &f, k);
+        assert!(pairs.values[0].abs() < 1e-9, "{:?}", &pairs.values[..3]);
+        // Bands: 2l + 1 values close to l(l+1), separated from the next band.
+        for l in 1..=lmax {
+            let band = &pairs.values[l * l..(l + 1) * (l + 1)];
+            let exact = (l * (l + 1)) as f64;
+            assert!(band.iter().all(|x| (x - exact).abs() < 0.05 * exact), "l = {l}: {band:?}");
+        }
+        assert!(pairs.orthonormality_error(&m.mass) < 1e-8);
+        errors.push(sphere_error(&pairs.values, lmax));
+    }
+    // Second-order convergence: halving the edge length divides the error by about 4.
+    assert!(errors[1] < errors[0] / 3.0, "errors under refinement: {errors:?}");
+}
+
+#[test]
+fn sparse_solver_agrees_with_dense_on_a_perturbed_sphere() {
+    let (mut v, f) = icosphere(3);
+    // Break the symmetry (distinct eigenvalues) deterministically.
+    for (i, p) in v.iter_mut().enumerate() {
+        let s = 1.0 + 0.05 * ((i as f64 * 1.618).sin());
+        *p = p.map(|c| c * s);
+    }
+    let k = 40;
+    let (m, pairs) = solve(&v, &f, k);
+    let dense = dense_eigenpairs(&m, k).unwrap();
+    for (i, (a, b)) in pairs.values.iter().zip(&dense.values).enumerate() {
+        assert!((a - b).abs() <= 1e-9 * b.abs().max(1.0), "pair {i}: {a} vs {b}");
+    }
+    // Eigenvectors agree up to sign where the eigenvalue is isolated.
+    for j in 1..k {
+        let gap = (dense.values[j] - dense.values[j - 1])
+            .min(dense.values.get(j + 1).map_or(f64::INFINITY, |x| x - dense.values[j]));
+        if gap < 1e-3 * dense.values[j] {
+            continue;
+        }
+        let dot: f64 = (0..m.vertex_count())
+            .map(|i| pairs.vectors[(i, j)] * m.mass[i] * dense.vectors[(i, j)])
+            .sum();
+        assert!((dot.abs() - 1.0).abs() < 1e-7, "pair {j}: |<phi, phi_dense>_M| = {dot}");
+    }
+    assert!(pairs.orthonormality_error(&m.mass) < 1e-8);
+    let res = pairs.relative_residuals(&m);
+    assert!(res.iter().all(|r| *r < 1e-6), "residuals {res:?}");
+}
+
+#[test]
+fn two_components_give_two_zero_eigenvalues() {
+    let (v1, f1) = icosphere(3);
+    let n1 = v1.len() as u32;
+    let mut v = v1.clone();
+    v.extend(v1.iter().map(|p| [p[0] * 0.5 + 3.0, p[1] * 0.5, p[2] * 0.5]));
+    let mut f = f1.clone();
+    f.extend(f1.iter().map(|t| t.map(|i| i + n1)));
+    let (m, pairs) = solve(&v, &f, 6);
+    assert!(pairs.values[0].abs() < 1e-9 && pairs.values[1].abs() < 1e-9, "{:?}", pairs.values);
+    // Next: l = 1 of the big sphere (radius 1: 2), then the small one has 8 (radius 0.5).
+    assert!((pairs.values[2] - 2.0).abs() < 0.05, "{:?}", pairs.values);
+    assert!(pairs.orthonormality_error(&m.mass) < 1e-8);
+}
+
+#[test]
+fn open_mesh_with_degenerate_triangles_gives_finite_neumann_spectrum() {
+    // A flat 2 x 1 rectangle, grid 24 x 12, plus degenerate triangles on existing vertices.
+    let (nx, ny) = (24usize, 12usize);
+    let mut v = Vec::new();
+    for j in 0..=ny {
+        for i in 0..=nx {
+            v.push([2.0 * i as f64 / nx as f64, j as f64 / ny as f64, 0.0]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+    let mut f = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            f.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            f.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    f.push([id(0, 0), id(1, 0), id(2, 0)]); // collinear
+    f.push([id(3, 3), id(3, 3), id(4, 4)]); // repeated index
+    let m = LboMatrices::assemble(&v, &f).unwrap();
+    assert_eq!(m.skipped_triangles, 2);
+    let (pairs, _) = smallest_eigenpairs(&m, 6, &small_settings()).unwrap();
+    // Neumann eigenvalues of [0,2]x[0,1]: (pi a / 2)^2 + (pi b)^2 = 0, pi^2/4, pi^2, pi^2 (a=2),
+    // 5 pi^2 / 4, 2 pi^2 (a=4) ...
+    let pi2 = std::f64::consts::PI.powi(2);
+    let exact = [0.0, pi2 / 4.0, pi2, pi2, 1.25 * pi2, 2.0 * pi2];
+    for (x, e) in pairs.values.iter().zip(exact) {
+        assert!(x.is_finite() && (x - e).abs() < 0.02 * e.max(1.0), "{:?}", pairs.values);
+    }
+}
+
+#[test]
+fn cache_computes_loads_and_detects_corruption() {
+    let (v, f) = icosphere(3);
+    let dir = common::temp_dir("lbo-cache");
+    let s = small_settings();
+    let (a, o) = cached_eigenpairs(&v, &f, 10, &s, &dir).unwrap();
+    assert_eq!(o, CacheOutcome::Computed);
+    let (b, o) = cached_eigenpairs(&v, &f, 10, &s, &dir).unwrap();
+    assert_eq!(o, CacheOutcome::Loaded);
+    assert_eq!(a.values, b.values);
+    assert_eq!(a.vectors, b.vectors);
+    let files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
+    assert_eq!(files.len(), 1, "{files:?}");
+    let mut bytes = std::fs::read(&files[0]).unwrap();
+    bytes[1000] ^= 0x01;
+    std::fs::write(&files[0], &bytes).unwrap();
+    let (c, o) = cached_eigenpairs(&v, &f, 10, &s, &dir).unwrap();
+    assert!(matches!(&o, CacheOutcome::Recomputed(r) if r.contains("checksum")), "{o:?}");
+    assert_eq!(c.values, a.values);
+    std::fs::write(&files[0], &bytes[..bytes.len() / 2]).unwrap();
+    let (_, o) = cached_eigenpairs(&v, &f, 10, &s, &dir).unwrap();
+    assert!(matches!(&o, CacheOutcome::Recomputed(r) if r.contains("truncated")), "{o:?}");
+    let (_, o) = cached_eigenpairs(&v, &f, 10, &s, &dir).unwrap();
+    assert_eq!(o, CacheOutcome::Loaded);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn spot_eigenpairs_and_encoding() {
+    let Some(data) = common::data_dir() else { return };
+    let loaded = load_mesh(data.join("meshes/spot.obj"), &LoadOptions::default()).unwrap();
+    let m = LboMatrices::from_mesh(&loaded.mesh).unwrap();
+    let k = 65;
+    let (pairs, report) = smallest_eigenpairs(&m, k, &EigenSettings::default()).unwrap();
+    assert!(!report.dense);
+    assert!(pairs.orthonormality_error(&m.mass) < 1e-8);
+    let res = pairs.relative_residuals(&m);
+    assert!(
+        res.iter().all(|r| *r < 1e-5),
+        "max residual {:?}",
+        res.iter().cloned().fold(0.0, f64::max)
+    );
+    assert!(pairs.values[0].abs() < 1e-8 && pairs.values[1] > 1e-3);
+    assert!(pairs.values.windows(2).all(|w| w[0] <= w[1]));
+
+    let config = LboEncodingConfig { selection: (0..64).collect(), ..Default::default() };
+    let enc = LboEncoding::new(&pairs, &config).unwrap();
+    assert_eq!((enc.vertex_count(), enc.dim()), (m.vertex_count(), 64));
+    for c in 0..64 {
+        let col = (0..enc.vertex_count()).map(|v| enc.vertex(v)[c]);
+        let (lo, hi) = col.fold((f32::MAX, f32::MIN), |(lo, hi), x| (lo.min(x), hi.max(x)));
+        assert!((hi - lo - 1.0).abs() < 1e-5, "column {c}: range {}", hi - lo);
+    }
+    let tri = loaded.mesh.triangles[100];
+    let at_corner = enc.interpolate(&loaded.mesh.triangles, &[(100, [0.0, 1.0, 0.0])]);
+    assert_eq!(at_corner, enc.vertex(tri[1] as usize));
+    // The default configuration needs 513 pairs.
+    assert!(LboEncoding::new(&pairs, &LboEncodingConfig::default()).is_err());
+}
