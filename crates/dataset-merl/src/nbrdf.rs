@@ -141,10 +141,10 @@ impl Nbrdf {
         }
         let last = self.layers.len() - 1;
         for (k, layer) in self.layers.iter().enumerate() {
-            for o in 0..layer.n_out {
-                let row = &layer.w[o * layer.n_in..(o + 1) * layer.n_in];
-                let s = row.iter().zip(&a[..layer.n_in]).fold(layer.b[o], |s, (w, x)| s + w * x);
-                b[o] = if k < last { s.max(0.0) } else { s };
+            let rows = layer.w.chunks_exact(layer.n_in);
+            for ((out, row), bias) in b.iter_mut().zip(rows).zip(&layer.b) {
+                let s = row.iter().zip(&a[..layer.n_in]).fold(*bias, |s, (w, x)| s + w * x);
+                *out = if k < last { s.max(0.0) } else { s };
             }
             std::mem::swap(&mut a, &mut b);
         }
