@@ -32,7 +32,6 @@ struct LayerJson {
 #[derive(Clone, Debug)]
 struct Dense {
     n_in: usize,
-    n_out: usize,
     w: Vec<f32>,
     b: Vec<f32>,
 }
@@ -102,7 +101,7 @@ impl Nbrdf {
             if w.iter().chain(&l.bias).any(|x| !x.is_finite()) {
                 return Err(fault(format!("layer {k}: non-finite weight")));
             }
-            layers.push(Dense { n_in: l.n_in, n_out: l.out, w, b: l.bias.clone() });
+            layers.push(Dense { n_in: l.n_in, w, b: l.bias.clone() });
             width = l.out;
         }
         if width != 3 {
