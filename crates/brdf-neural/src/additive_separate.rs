@@ -1,0 +1,58 @@
+//! Additive Separate (NeRFactor-style split, spec 4.3) and its enhanced variant (spec 4.5):
+//! f = f_d(x) + f_s(x, l, v), two independent 4 x 128 MLPs with the input concatenated after
+//! hidden layer 2; f_d = sigmoid / pi, f_s = 0.5 softplus. Enhanced: the specular MLP also
+//! outputs xi in [0, 1]^3 and f = (1 - xi) f_d + f_s.
+//!
+//! NOL ablation: the specular MLP has 2 hidden layers and no skip. NeRFactor ablations: albedo
+//! clamped into [0.0023, 0.6038], scalar specular.
+
+use crate::mlp::{Mlp, MlpConfig};
+use crate::output::{AdditiveHead, BrdfOutput};
+use burn::module::Module;
+use burn::tensor::Tensor;
+
+/// Additive Separate (plain or enhanced).
+#[derive(Module, Debug)]
+pub struct AdditiveSeparate {
+    /// Diffuse MLP, input: spatial features.
+    pub diffuse: Mlp,
+    /// Specular MLP, input: [spatial features, PE(angles)].
+    pub specular: Mlp,
+    #[module(skip)]
+    head: AdditiveHead,
+}
+
+/// The two MLP configurations (diffuse, specular).
+pub(crate) fn additive_separate_configs(c: &crate::ModelConfig) -> (MlpConfig, MlpConfig) {
+    let head = c.additive_head();
+    let mut d = MlpConfig::new(c.spatial_dim);
+    d.width = c.width;
+    d.hidden_layers = 4;
+    d.d_output = Some(3);
+    d.skip_into = Some(c.separate_skip_at + 1);
+    let mut s = d.clone();
+    s.d_output = Some(head.specular_outputs());
+    s.d_late = c.angles.dim();
+    if c.nol {
+        s.hidden_layers = 2;
+        s.skip_into = None;
+    }
+    (d, s)
+}
+
+impl AdditiveSeparate {
+    pub(crate) fn new(diffuse: Mlp, specular: Mlp, head: AdditiveHead) -> Self {
+        Self { diffuse, specular, head }
+    }
+
+    /// Evaluates the model.
+    ///
+    /// # Shapes
+    /// - spatial: `[batch, spatial_dim]`; angles: `[batch, angle_dim]`
+    /// - output: `f`, `diffuse`, `specular` (and `xi` when enhanced) `[batch, 3]`
+    pub fn forward(&self, spatial: Tensor<2>, angles: Tensor<2>) -> BrdfOutput {
+        let d = self.diffuse.forward(spatial.clone(), None);
+        let s = self.specular.forward(spatial, Some(angles));
+        self.head.combine(d, s)
+    }
+}

@@ -1,0 +1,28 @@
+//! The crate's error type.
+
+use crate::device::Backend;
+
+/// Everything that can go wrong when configuring a model or building a batch. Evaluating a
+/// model never fails.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A model configuration combines options the paper does not combine, or has a value out
+    /// of range; the message names the field.
+    #[error("invalid model configuration: {0}")]
+    InvalidConfig(String),
+    /// A model name that is neither a configuration name nor a paper table row.
+    #[error("unknown model name {0:?} (see ModelKind::ALL for the names)")]
+    UnknownModel(String),
+    /// A backend name other than flex, ndarray or wgpu.
+    #[error("unknown backend {0:?} (expected flex, ndarray or wgpu)")]
+    UnknownBackend(String),
+    /// A backend whose cargo feature is off in this build.
+    #[error("backend {0:?} is not built in: enable the cargo feature of brdf-neural")]
+    BackendNotBuilt(Backend),
+    /// Sample arrays whose lengths disagree.
+    #[error("batch shape: {0}")]
+    BatchShape(String),
+}
+
+/// `Result` with this crate's [`Error`].
+pub type Result<T> = std::result::Result<T, Error>;

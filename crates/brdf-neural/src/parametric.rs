@@ -1,0 +1,226 @@
+//! Parametric models (spec 3 and 4.1): an MLP (6 x 128, ReLU, input skip to layer 3) maps the
+//! spatial features of x to the parameters of an analytic BRDF, which a tensor twin of the
+//! `brdf-analytic` model then evaluates for the sample's directions.
+//!
+//! Output nonlinearities ("sigmoid or softplus depending on the range"; roughness scaled by 0.5
+//! before its sigmoid):
+//!
+//! | model | outputs | mapping |
+//! | --- | --- | --- |
+//! | RP | 7 | k = sigmoid (RGB), zeta = sigmoid (RGB), k_d = zeta k, k_s = (1 - zeta) k, N = 1 + softplus |
+//! | TS | 7 | r = sigmoid(0.5 z), rho_d = sigmoid (RGB), F0 = sigmoid (RGB) |
+//! | Disney | 12 | base colour (RGB) and the 9 scalars, all sigmoid; roughness sigmoid(0.5 z); anisotropic fixed to 0 (not predicted) |
+//! | FMBRDF | 6 + 2 global | eta = 1.1 + 1.4 sigmoid, rho = sigmoid (RGB), k_s = softplus, kappa = 100 sigmoid per point; alpha = 0.001 + (2 pi - 0.001) sigmoid(a), beta = 0.5 + 3.5 sigmoid(b) with a, b two trainable scalars per object |
+//!
+//! (The spec counts 13 Disney outputs: its 10 scalars include anisotropic, which the paper fixes
+//! to 0, so it is not an output here.)
+
+use crate::mlp::{Mlp, MlpConfig};
+use crate::output::BrdfOutput;
+use crate::tensor_brdf::{
+    DisneyTensorParams, FmbrdfNets, FmbrdfTensorParams, Geometry, PhongTensorParams,
+    TorranceSparrowTensorParams, disney, fmbrdf, realistic_phong, torrance_sparrow,
+};
+use burn::module::{Module, Param};
+use burn::tensor::activation::{sigmoid, softplus};
+use burn::tensor::{Device, Tensor, TensorData};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::TAU;
+
+/// Which analytic model a parametric model drives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Analytic {
+    /// Realistic Phong.
+    RealisticPhong,
+    /// Torrance-Sparrow (GGX).
+    TorranceSparrow,
+    /// Isotropic Disney.
+    Disney,
+    /// Fresnel microfacet BRDF.
+    Fmbrdf,
+}
+
+impl Analytic {
+    /// Number of per-point MLP outputs.
+    pub fn outputs(self) -> usize {
+        match self {
+            Analytic::RealisticPhong | Analytic::TorranceSparrow => 7,
+            Analytic::Disney => 12,
+            Analytic::Fmbrdf => 6,
+        }
+    }
+}
+
+/// FMBRDF ranges of the global alpha and beta.
+pub const FMBRDF_ALPHA_RANGE: (f64, f64) = (0.001, TAU);
+/// See [`FMBRDF_ALPHA_RANGE`].
+pub const FMBRDF_BETA_RANGE: (f64, f64) = (0.5, 4.0);
+/// Initial alpha and beta (the scalar model's defaults).
+const FMBRDF_INIT: (f64, f64) = (0.3, 2.0);
+
+/// The parameters a parametric model predicts for a batch.
+#[allow(clippy::large_enum_variant)] // one per forward pass; Disney has 10 tensors
+#[derive(Clone, Debug)]
+pub enum BrdfParams {
+    /// Realistic Phong.
+    RealisticPhong(PhongTensorParams),
+    /// Torrance-Sparrow.
+    TorranceSparrow(TorranceSparrowTensorParams),
+    /// Disney.
+    Disney(DisneyTensorParams),
+    /// FMBRDF.
+    Fmbrdf(FmbrdfTensorParams),
+}
+
+/// A parametric model.
+#[derive(Module, Debug)]
+pub struct ParametricModel {
+    /// The parameter MLP (spatial features -> raw outputs).
+    pub mlp: Mlp,
+    /// FMBRDF: the raw global alpha, `[1, 1]`.
+    pub fm_alpha: Option<Param<Tensor<2>>>,
+    /// FMBRDF: the raw global beta, `[1, 1]`.
+    pub fm_beta: Option<Param<Tensor<2>>>,
+    /// FMBRDF: the fixed helper networks.
+    pub fm_nets: Option<FmbrdfNets>,
+    #[module(skip)]
+    analytic: Analytic,
+    #[module(skip)]
+    gamma_base_color: bool,
+}
+
+/// The parameter MLP's configuration.
+pub(crate) fn parametric_config(c: &crate::ModelConfig, analytic: Analytic) -> MlpConfig {
+    let mut m = MlpConfig::new(c.spatial_dim);
+    m.width = c.width;
+    m.hidden_layers = 5;
+    m.d_output = Some(analytic.outputs());
+    m.skip_into = Some(c.skip_layer);
+    m
+}
+
+fn logit(p: f64) -> f64 {
+    (p / (1.0 - p)).ln()
+}
+
+fn scalar_param(x: f64, device: &Device) -> Param<Tensor<2>> {
+    Param::from_tensor(Tensor::from_data(TensorData::new(vec![x as f32], [1, 1]), device))
+}
+
+/// sigmoid mapped into [lo, hi].
+fn ranged(z: Tensor<2>, (lo, hi): (f64, f64)) -> Tensor<2> {
+    sigmoid(z).mul_scalar(hi - lo).add_scalar(lo)
+}
+
+impl ParametricModel {
+    pub(crate) fn new(
+        mlp: Mlp,
+        analytic: Analytic,
+        gamma_base_color: bool,
+        device: &Device,
+    ) -> Self {
+        let fm = analytic == Analytic::Fmbrdf;
+        let init = |x: f64, (lo, hi): (f64, f64)| scalar_param(logit((x - lo) / (hi - lo)), device);
+        Self {
+            mlp,
+            fm_alpha: fm.then(|| init(FMBRDF_INIT.0, FMBRDF_ALPHA_RANGE)),
+            fm_beta: fm.then(|| init(FMBRDF_INIT.1, FMBRDF_BETA_RANGE)),
+            fm_nets: fm.then(|| FmbrdfNets::new(device)),
+            analytic,
+            gamma_base_color,
+        }
+    }
+
+    /// The analytic model this one drives.
+    pub fn analytic(&self) -> Analytic {
+        self.analytic
+    }
+
+    /// The BRDF parameters of each sample.
+    ///
+    /// # Shapes
+    /// - spatial: `[batch, spatial_dim]`
+    /// - output: per-sample tensors `[batch, k]` (FMBRDF alpha and beta `[1, 1]`)
+    pub fn params(&self, spatial: Tensor<2>) -> BrdfParams {
+        let z = self.mlp.forward(spatial, None);
+        let col = |k: usize, n: usize| z.clone().narrow(1, k, n);
+        match self.analytic {
+            Analytic::RealisticPhong => {
+                let k = sigmoid(col(0, 3));
+                let zeta = sigmoid(col(3, 3));
+                PhongTensorParams {
+                    kd: zeta.clone() * k.clone(),
+                    ks: zeta.neg().add_scalar(1.0) * k,
+                    exponent: softplus(col(6, 1), 1.0).add_scalar(1.0),
+                }
+                .into()
+            }
+            Analytic::TorranceSparrow => TorranceSparrowTensorParams {
+                roughness: sigmoid(col(0, 1).mul_scalar(0.5)),
+                diffuse: sigmoid(col(1, 3)),
+                f0: sigmoid(col(4, 3)),
+            }
+            .into(),
+            Analytic::Disney => DisneyTensorParams {
+                base_color: sigmoid(col(0, 3)),
+                metallic: sigmoid(col(3, 1)),
+                subsurface: sigmoid(col(4, 1)),
+                specular: sigmoid(col(5, 1)),
+                roughness: sigmoid(col(6, 1).mul_scalar(0.5)),
+                specular_tint: sigmoid(col(7, 1)),
+                sheen: sigmoid(col(8, 1)),
+                sheen_tint: sigmoid(col(9, 1)),
+                clearcoat: sigmoid(col(10, 1)),
+                clearcoat_gloss: sigmoid(col(11, 1)),
+                gamma_base_color: self.gamma_base_color,
+            }
+            .into(),
+            Analytic::Fmbrdf => {
+                let raw = |p: &Option<Param<Tensor<2>>>| p.as_ref().expect("FMBRDF global").val();
+                FmbrdfTensorParams {
+                    eta: ranged(col(0, 1), (1.1, 2.5)),
+                    rho: sigmoid(col(1, 3)),
+                    k_s: softplus(col(4, 1), 1.0),
+                    kappa: sigmoid(col(5, 1)).mul_scalar(100.0),
+                    alpha: ranged(raw(&self.fm_alpha), FMBRDF_ALPHA_RANGE),
+                    beta: ranged(raw(&self.fm_beta), FMBRDF_BETA_RANGE),
+                }
+                .into()
+            }
+        }
+    }
+
+    /// Evaluates the model.
+    ///
+    /// # Shapes
+    /// - spatial: `[batch, spatial_dim]`; geometry of `batch` pairs
+    /// - output: `f` `[batch, 3]`
+    pub fn forward(&self, spatial: Tensor<2>, geometry: &Geometry) -> BrdfOutput {
+        let f = match self.params(spatial) {
+            BrdfParams::RealisticPhong(p) => realistic_phong(&p, geometry),
+            BrdfParams::TorranceSparrow(p) => torrance_sparrow(&p, geometry),
+            BrdfParams::Disney(p) => disney(&p, geometry),
+            BrdfParams::Fmbrdf(p) => {
+                fmbrdf(&p, self.fm_nets.as_ref().expect("FMBRDF nets"), geometry)
+            }
+        };
+        BrdfOutput { f, diffuse: None, specular: None, xi: None }
+    }
+}
+
+macro_rules! into_params {
+    ($($t:ident => $v:ident),*) => {$(
+        impl From<$t> for BrdfParams {
+            fn from(p: $t) -> Self {
+                BrdfParams::$v(p)
+            }
+        }
+    )*};
+}
+into_params!(
+    PhongTensorParams => RealisticPhong,
+    TorranceSparrowTensorParams => TorranceSparrow,
+    DisneyTensorParams => Disney,
+    FmbrdfTensorParams => Fmbrdf
+);
