@@ -1,5 +1,5 @@
-//! The MERL BRDF format (spec section 1), the MERL-derived material catalogue, and (with the
-//! dataset issue) the semi-synthetic scene generator.
+//! The MERL BRDF format (spec section 1), the MERL-derived material catalogue, and the
+//! semi-synthetic scene generator with the dataset API training reads.
 //!
 //! * [`merl`]: the real binary format (reader, validating parser, atomic writer), lookup by
 //!   Rusinkiewicz angles or directions with the reference nearest-lower-bin rule or trilinear
@@ -9,6 +9,8 @@
 //! * [`catalogue`]: the 25 materials the project uses, shipped as NBRDF networks (MIT); real
 //!   MERL binaries from a configured directory take precedence. Results made from the networks
 //!   are labelled "MERL-derived (NBRDF)".
+//! * [`scene`]: semi-synthetic scenes: generation into a self-describing directory (EXR images,
+//!   masks, ground-truth BRDF, flags, manifest) and [`SceneDataset`] to read them back.
 //!
 //! ```
 //! use dataset_merl::{Lookup, load_material};
@@ -24,9 +26,11 @@ pub mod catalogue;
 mod error;
 pub mod merl;
 pub mod nbrdf;
+pub mod scene;
 
 pub use catalogue::{CATALOGUE, Material, MaterialClass, MaterialSource, load_material};
 pub use error::{Error, Result};
 pub use merl::lookup::MerlMaterial;
 pub use merl::{Lookup, MerlBrdf};
 pub use nbrdf::Nbrdf;
+pub use scene::{SampleSet, SceneConfig, SceneDataset, generate_scene};

@@ -1,0 +1,180 @@
+//! What a semi-synthetic scene is made of: mesh, material, seed and settings (spec section 6 and
+//! the decisions table). Every value is configurable; the defaults are the paper's setup.
+
+use crate::error::{Error, Result};
+use crate::merl::Lookup;
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// The material rendered onto the mesh.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum MaterialSpec {
+    /// A catalogue material by MERL name (a real MERL binary from `merl_dir` when present,
+    /// else the shipped NBRDF network).
+    Merl {
+        /// The MERL name, for example "blue-acrylic".
+        name: String,
+    },
+    /// A Lambertian material (for tests and sanity checks).
+    Lambert {
+        /// Albedo, linear RGB in [0, 1].
+        albedo: [f32; 3],
+    },
+}
+
+/// Rendering settings of a scene.
+///
+/// | key | default | meaning |
+/// | --- | --- | --- |
+/// | `width`, `height` | 512 | image size in pixels |
+/// | `views` | 20 | cameras on a sphere around the normalised mesh |
+/// | `train_views` | 10 | of which used for training (chosen by the seed); the rest test |
+/// | `lights_per_view` | 42 | directional lights per view, within 60 degrees of the camera |
+/// | `train_lights` | 30 | the first lights of a view are training lights, the rest test |
+/// | `fov_y_deg` | 40 | vertical field of view |
+/// | `camera_distance` | 3 | camera distance from the origin (mesh in the unit sphere) |
+/// | `light_intensity` | (pi, pi, pi) | irradiance E of every light, RGB (a white Lambertian at normal incidence renders 1) |
+/// | `noise_sigma` | 1e-3 | Gaussian noise per channel, absolute, on linear values |
+/// | `saturation` | 2.0 | observed values are clipped here; such pixels are flagged saturated |
+/// | `lookup` | nearest-lower | MERL lookup rule |
+/// | `shadow_bias_relative` | 1e-4 | shadow-ray offset as a fraction of the mesh diagonal |
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SceneSettings {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Number of views.
+    pub views: usize,
+    /// Number of training views.
+    pub train_views: usize,
+    /// Lights per view.
+    pub lights_per_view: usize,
+    /// Training lights per view.
+    pub train_lights: usize,
+    /// Vertical field of view, degrees.
+    pub fov_y_deg: f32,
+    /// Camera distance from the origin.
+    pub camera_distance: f32,
+    /// Light irradiance, RGB.
+    pub light_intensity: [f32; 3],
+    /// Noise standard deviation.
+    pub noise_sigma: f32,
+    /// Saturation (clip) level.
+    pub saturation: f32,
+    /// MERL lookup rule.
+    pub lookup: Lookup,
+    /// Shadow bias relative to the mesh diagonal.
+    pub shadow_bias_relative: f32,
+}
+
+impl Default for SceneSettings {
+    fn default() -> Self {
+        let pi = std::f32::consts::PI;
+        Self {
+            width: 512,
+            height: 512,
+            views: 20,
+            train_views: 10,
+            lights_per_view: 42,
+            train_lights: 30,
+            fov_y_deg: 40.0,
+            camera_distance: 3.0,
+            light_intensity: [pi; 3],
+            noise_sigma: 1e-3,
+            saturation: 2.0,
+            lookup: Lookup::NearestLower,
+            shadow_bias_relative: 1e-4,
+        }
+    }
+}
+
+/// A complete scene description: the input of the generator.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneConfig {
+    /// The mesh file (OBJ, PLY, glTF/GLB); it is cleaned and normalised into the unit sphere.
+    pub mesh: PathBuf,
+    /// The material.
+    pub material: MaterialSpec,
+    /// Seed of every random choice (view split, lights, noise).
+    pub seed: u64,
+    /// Rendering settings.
+    #[serde(default)]
+    pub settings: SceneSettings,
+    /// Directory with real MERL binaries (`<name>.binary`), which take precedence.
+    #[serde(default)]
+    pub merl_dir: Option<PathBuf>,
+}
+
+impl SceneConfig {
+    /// Parses a JSON configuration; unknown keys are errors naming the key.
+    pub fn from_json(text: &str) -> Result<Self> {
+        let c: Self = serde_json::from_str(text)
+            .map_err(|e| Error::Config { key: "<document>".into(), fault: e.to_string() })?;
+        c.validate()?;
+        Ok(c)
+    }
+
+    /// Checks every value; the error names the key.
+    pub fn validate(&self) -> Result<()> {
+        let s = &self.settings;
+        let bad = |key: &str, fault: String| Err(Error::Config { key: key.into(), fault });
+        if s.width == 0 || s.height == 0 || s.width > 16384 || s.height > 16384 {
+            return bad(
+                "settings.width/height",
+                format!("{} x {} is not in 1..=16384", s.width, s.height),
+            );
+        }
+        if s.views == 0 || s.train_views > s.views {
+            return bad("settings.train_views", format!("{} of {} views", s.train_views, s.views));
+        }
+        if s.lights_per_view == 0 || s.train_lights > s.lights_per_view {
+            return bad(
+                "settings.train_lights",
+                format!("{} of {} lights", s.train_lights, s.lights_per_view),
+            );
+        }
+        if !(s.fov_y_deg > 0.0 && s.fov_y_deg < 179.0) {
+            return bad("settings.fov_y_deg", format!("{} is not in (0, 179)", s.fov_y_deg));
+        }
+        if !(s.camera_distance > 1.0 && s.camera_distance.is_finite()) {
+            return bad(
+                "settings.camera_distance",
+                format!("{} must exceed 1 (the mesh's radius)", s.camera_distance),
+            );
+        }
+        if s.light_intensity.iter().any(|e| !(e.is_finite() && *e >= 0.0)) {
+            return bad(
+                "settings.light_intensity",
+                format!("{:?} must be finite and >= 0", s.light_intensity),
+            );
+        }
+        if !(s.noise_sigma >= 0.0 && s.noise_sigma.is_finite()) {
+            return bad(
+                "settings.noise_sigma",
+                format!("{} must be finite and >= 0", s.noise_sigma),
+            );
+        }
+        if s.saturation.is_nan() || s.saturation <= 0.0 {
+            return bad("settings.saturation", format!("{} must be > 0", s.saturation));
+        }
+        if !(s.shadow_bias_relative >= 0.0 && s.shadow_bias_relative < 0.1) {
+            return bad(
+                "settings.shadow_bias_relative",
+                format!("{} is not in [0, 0.1)", s.shadow_bias_relative),
+            );
+        }
+        if let MaterialSpec::Lambert { albedo } = &self.material
+            && albedo.iter().any(|a| !(0.0..=1.0).contains(a))
+        {
+            return bad("material.albedo", format!("{albedo:?} is not in [0, 1]"));
+        }
+        if let MaterialSpec::Merl { name } = &self.material {
+            crate::catalogue::entry(name)?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,300 @@
+//! The semi-synthetic scene generator: mesh + material + seed + settings -> a self-describing
+//! scene directory (spec section 6), written atomically and skipped when already complete.
+//!
+//! Directory layout (all paths relative to the scene directory):
+//!
+//! | path | contents |
+//! | --- | --- |
+//! | `manifest.json` | [`Manifest`]: config, cameras, lights, splits, file hashes, statistics |
+//! | `mesh.ply` | the cleaned mesh normalised into the unit sphere, binary PLY |
+//! | `masks/vVV.png` | object mask of view VV, 8-bit (255 = object) |
+//! | `images/vVV_lLL.exr` | observed linear HDR radiance, RGB float |
+//! | `brdf/vVV_lLL.exr` | ground-truth BRDF (1/sr) where lit and valid, else 0 |
+//! | `flags/vVV_lLL.png` | per-pixel [`flag`](super::render::flag) bits (lit, shadowed, back-facing, GT valid, saturated) |
+//! | `geometry/` | the ray-casting precompute, content-keyed cache (rebuilt if damaged) |
+//!
+//! The directory is assembled under a temporary name beside the target and renamed into place
+//! when complete, so an interrupted run never leaves a half-written scene behind.
+
+use super::config::{MaterialSpec, SceneConfig};
+use super::manifest::{
+    FileEntry, LightInfo, MANIFEST_FILE, Manifest, SceneStats, Split, VERSION, ViewInfo, hash_hex,
+};
+use super::render::{GroundTruth, Sensor, flag, render_light};
+use super::{images, mesh_file};
+use crate::catalogue::load_material;
+use crate::error::{Error, Result};
+use glam::{Mat3, Vec3};
+use raycast_precompute::{Camera, PrecomputeSettings, ShadowBias, View, precompute_cached};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// What [`generate_scene`] did.
+#[derive(Clone, Debug)]
+pub struct GenerateReport {
+    /// The scene directory.
+    pub dir: PathBuf,
+    /// True when a complete scene with the same configuration was already there.
+    pub skipped: bool,
+    /// Wall time in seconds.
+    pub seconds: f64,
+    /// Size of the listed data files in bytes.
+    pub bytes: u64,
+    /// Provenance label.
+    pub label: String,
+    /// Sample statistics.
+    pub stats: SceneStats,
+}
+
+/// File stem of (view, light) data.
+pub fn sample_stem(view: usize, light: usize) -> String {
+    format!("v{view:02}_l{light:02}")
+}
+
+/// Indices of the training views: a seeded shuffle of 0..views, first `train` of them, sorted.
+fn train_views(views: usize, train: usize, seed: u64) -> Vec<bool> {
+    let mut order: Vec<usize> = (0..views).collect();
+    let mut state = seed ^ 0x5CE9_E5EE_D000_0001;
+    for i in (1..views).rev() {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        let j = ((state >> 33) % (i as u64 + 1)) as usize;
+        order.swap(i, j);
+    }
+    let mut is_train = vec![false; views];
+    for &v in &order[..train] {
+        is_train[v] = true;
+    }
+    is_train
+}
+
+fn rows(m: Mat3) -> [[f32; 3]; 3] {
+    [m.row(0).to_array(), m.row(1).to_array(), m.row(2).to_array()]
+}
+
+/// Generates the scene of `config` into `out` (or keeps it, when a complete scene with the same
+/// configuration is already there). Shows a progress bar when `progress` is true.
+pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Result<GenerateReport> {
+    let start = Instant::now();
+    config.validate()?;
+    if let Ok(m) = Manifest::read(&out.join(MANIFEST_FILE))
+        && m.config == *config
+        && m.verify_files(out).is_ok()
+    {
+        {
+            let bytes = m.files.iter().map(|f| f.bytes).sum();
+            return Ok(GenerateReport {
+                dir: out.into(),
+                skipped: true,
+                seconds: start.elapsed().as_secs_f64(),
+                bytes,
+                label: m.label,
+                stats: m.stats,
+            });
+        }
+    }
+    let s = &config.settings;
+    let options = mesh_encoding::LoadOptions { cleanup: true, normalize_unit_sphere: true };
+    let mesh = mesh_encoding::load_mesh(&config.mesh, &options)?.mesh;
+
+    let (label, gt): (String, Box<GroundTruth<'static>>) = match &config.material {
+        MaterialSpec::Merl { name } => {
+            let m = load_material(name, config.merl_dir.as_deref())?;
+            let (table, lookup) = (m.table, s.lookup);
+            (m.source.label().to_string(), Box::new(move |l, v| table.eval_dirs(l, v, lookup)))
+        }
+        MaterialSpec::Lambert { albedo } => {
+            let f = albedo.map(|a| a as f64 / std::f64::consts::PI);
+            ("analytic (Lambert)".to_string(), Box::new(move |_, _| Some(f)))
+        }
+    };
+
+    let orbit = raycast_precompute::scenes::orbit_views(
+        s.views,
+        s.lights_per_view,
+        s.width,
+        s.camera_distance,
+        s.fov_y_deg,
+        config.seed,
+    );
+    let views: Vec<View> = orbit
+        .into_iter()
+        .map(|v| {
+            let camera = if s.width == s.height {
+                v.camera
+            } else {
+                Camera::look_at(
+                    v.camera.center(),
+                    Vec3::ZERO,
+                    Vec3::Z,
+                    s.fov_y_deg,
+                    s.width,
+                    s.height,
+                )?
+            };
+            Ok(View { camera, lights: v.lights, mask: None })
+        })
+        .collect::<Result<_>>()?;
+    let is_train = train_views(s.views, s.train_views, config.seed);
+
+    // Assemble under a temporary name beside the target.
+    let name = out.file_name().and_then(|n| n.to_str()).unwrap_or("scene");
+    let tmp = out.with_file_name(format!(".{name}.partial-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    for sub in ["images", "brdf", "flags", "masks"] {
+        std::fs::create_dir_all(tmp.join(sub)).map_err(|e| Error::io(tmp.join(sub), e))?;
+    }
+    let result = (|| {
+        let settings = PrecomputeSettings {
+            shadow_bias: ShadowBias::Relative(s.shadow_bias_relative),
+            ..Default::default()
+        };
+        let (geometry, _) = precompute_cached(&mesh, &views, &settings, &tmp.join("geometry"))?;
+        let mut files = Mutex::new(Vec::new());
+        let mut record = |rel: String, bytes: &[u8]| -> Result<()> {
+            let path = tmp.join(&rel);
+            std::fs::write(&path, bytes).map_err(|e| Error::io(&path, e))?;
+            let entry = FileEntry { path: rel, bytes: bytes.len() as u64, xxh3: hash_hex(bytes) };
+            files.get_mut().unwrap().push(entry);
+            Ok(())
+        };
+        record("mesh.ply".into(), &mesh_file::ply_bytes(&mesh))?;
+        for (vi, vp) in geometry.views.iter().enumerate() {
+            let mut mask = vec![0u8; (vp.width * vp.height) as usize];
+            for &p in &vp.pixels {
+                mask[p as usize] = 255;
+            }
+            let rel = format!("masks/v{vi:02}.png");
+            images::write_png_gray(&tmp.join(&rel), vp.width, vp.height, &mask)?;
+            let bytes = std::fs::read(tmp.join(&rel)).map_err(|e| Error::io(tmp.join(&rel), e))?;
+            record(rel, &bytes)?;
+        }
+
+        let jobs: Vec<(usize, usize)> =
+            (0..s.views).flat_map(|v| (0..s.lights_per_view).map(move |l| (v, l))).collect();
+        let bar = if progress {
+            indicatif::ProgressBar::new(jobs.len() as u64)
+        } else {
+            indicatif::ProgressBar::hidden()
+        };
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{msg} [{bar:30}] {pos}/{len} images, {elapsed} elapsed, eta {eta}",
+            )
+            .expect("valid template"),
+        );
+        bar.set_message(format!("rendering {}", out.display()));
+        let stats = Mutex::new(SceneStats::default());
+        jobs.par_iter().try_for_each(|&(vi, li)| -> Result<()> {
+            let vp = &geometry.views[vi];
+            let sensor = Sensor {
+                noise_sigma: s.noise_sigma,
+                saturation: s.saturation,
+                seed: config.seed
+                    ^ ((vi as u64) << 32 | li as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15),
+            };
+            let img = render_light(vp, li, s.light_intensity, gt.as_ref(), sensor);
+            let (w, h) = (vp.width as usize, vp.height as usize);
+            let stem = sample_stem(vi, li);
+            let mut out_files = Vec::with_capacity(3);
+            for (dir, data) in [("images", &img.observed), ("brdf", &img.brdf)] {
+                let rel = format!("{dir}/{stem}.exr");
+                images::write_exr_rgb(&tmp.join(&rel), w, h, data)?;
+                out_files.push(rel);
+            }
+            let rel = format!("flags/{stem}.png");
+            images::write_png_gray(&tmp.join(&rel), vp.width, vp.height, &img.flags)?;
+            out_files.push(rel);
+            let mut entries = Vec::with_capacity(3);
+            for rel in out_files {
+                let path = tmp.join(&rel);
+                let bytes = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
+                entries.push(FileEntry {
+                    path: rel,
+                    bytes: bytes.len() as u64,
+                    xxh3: hash_hex(&bytes),
+                });
+            }
+            files.lock().unwrap().extend(entries);
+            let mut st = stats.lock().unwrap();
+            for &f in &img.flags {
+                st.lit_samples += u64::from(f & flag::LIT != 0);
+                st.shadowed_samples += u64::from(f & flag::SHADOWED != 0);
+                st.back_facing_samples += u64::from(f & flag::BACK_FACING != 0);
+                st.saturated_samples += u64::from(f & flag::SATURATED != 0);
+                st.invalid_gt_samples += u64::from(f & flag::LIT != 0 && f & flag::GT_VALID == 0);
+            }
+            bar.inc(1);
+            Ok(())
+        })?;
+        bar.finish_and_clear();
+
+        let mut stats = stats.into_inner().unwrap();
+        stats.foreground_pixels = geometry.views.iter().map(|v| v.len() as u64).sum();
+        let all = stats.lit_samples + stats.shadowed_samples + stats.back_facing_samples;
+        stats.saturated_fraction = stats.saturated_samples as f64 / all.max(1) as f64;
+        let mut files = files.into_inner().unwrap();
+        files.sort_by(|a, b| a.path.cmp(&b.path));
+        let view_infos = views
+            .iter()
+            .enumerate()
+            .map(|(vi, v)| {
+                let split = |train: bool| if train { Split::Train } else { Split::Test };
+                ViewInfo {
+                    split: split(is_train[vi]),
+                    k: rows(v.camera.k),
+                    r: rows(v.camera.r),
+                    t: v.camera.t.to_array(),
+                    lights: v
+                        .lights
+                        .iter()
+                        .enumerate()
+                        .map(|(li, d)| LightInfo {
+                            direction: d.to_array(),
+                            intensity: s.light_intensity,
+                            split: split(li < s.train_lights),
+                        })
+                        .collect(),
+                }
+            })
+            .collect();
+        let mut manifest = Manifest {
+            format: super::manifest::FORMAT.into(),
+            version: VERSION,
+            generator: format!("dataset-merl {}", env!("CARGO_PKG_VERSION")),
+            label: label.clone(),
+            config: config.clone(),
+            mesh_file: "mesh.ply".into(),
+            mesh_vertices: mesh.positions.len(),
+            mesh_triangles: mesh.triangles.len(),
+            views: view_infos,
+            files,
+            stats,
+            checksum: String::new(),
+        };
+        let json = manifest.to_json();
+        let path = tmp.join(MANIFEST_FILE);
+        std::fs::write(&path, json).map_err(|e| Error::io(&path, e))?;
+        Ok(manifest)
+    })();
+    let manifest = match result {
+        Ok(m) => m,
+        Err(e) => {
+            let _ = std::fs::remove_dir_all(&tmp);
+            return Err(e);
+        }
+    };
+    if out.exists() {
+        std::fs::remove_dir_all(out).map_err(|e| Error::io(out, e))?;
+    }
+    std::fs::rename(&tmp, out).map_err(|e| Error::io(out, e))?;
+    Ok(GenerateReport {
+        dir: out.into(),
+        skipped: false,
+        seconds: start.elapsed().as_secs_f64(),
+        bytes: manifest.files.iter().map(|f| f.bytes).sum(),
+        label,
+        stats: manifest.stats,
+    })
+}

@@ -1,0 +1,72 @@
+//! Image files of a scene: linear HDR RGB as float EXR (ZIP compressed), masks and flags as 8-bit
+//! grayscale PNG.
+
+use crate::error::{Error, Result};
+use exr::prelude::*;
+use std::path::Path;
+
+fn image_err(path: &Path, e: impl std::fmt::Display) -> Error {
+    Error::Image { path: path.into(), fault: e.to_string() }
+}
+
+/// Writes a row-major RGB f32 image as an EXR file (ZIP compression, lossless).
+pub fn write_exr_rgb(path: &Path, width: usize, height: usize, rgb: &[[f32; 3]]) -> Result<()> {
+    if rgb.len() != width * height {
+        return Err(image_err(path, format!("{} pixels for {width} x {height}", rgb.len())));
+    }
+    let channels = SpecificChannels::rgb(|Vec2(x, y)| {
+        let p: [f32; 3] = rgb[y * width + x];
+        (p[0], p[1], p[2])
+    });
+    Image::from_encoded_channels((width, height), Encoding::SMALL_LOSSLESS, channels)
+        .write()
+        .non_parallel()
+        .to_file(path)
+        .map_err(|e| image_err(path, e))
+}
+
+/// Reads an RGB EXR file: (width, height, row-major pixels). Non-finite values are an error.
+pub fn read_exr_rgb(path: &Path) -> Result<(usize, usize, Vec<[f32; 3]>)> {
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgb_channels(
+            |size, _| (size.0, vec![[0.0_f32; 3]; size.0 * size.1]),
+            |(w, px): &mut (usize, Vec<[f32; 3]>), Vec2(x, y), (r, g, b): (f32, f32, f32)| {
+                px[y * *w + x] = [r, g, b];
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .non_parallel()
+        .from_file(path)
+        .map_err(|e| image_err(path, e))?;
+    let size = image.layer_data.size;
+    let (_, px) = image.layer_data.channel_data.pixels;
+    if let Some(i) = px.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+        return Err(image_err(
+            path,
+            format!("non-finite value at pixel ({}, {})", i % size.0, i / size.0),
+        ));
+    }
+    Ok((size.0, size.1, px))
+}
+
+/// Writes an 8-bit grayscale PNG.
+pub fn write_png_gray(path: &Path, width: u32, height: u32, data: &[u8]) -> Result<()> {
+    image::save_buffer(path, data, width, height, image::ExtendedColorType::L8)
+        .map_err(|e| image_err(path, e))
+}
+
+/// Reads an 8-bit grayscale PNG: (width, height, data).
+pub fn read_png_gray(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
+    let img = image::open(path).map_err(|e| image_err(path, e))?;
+    if !matches!(img.color(), image::ColorType::L8) {
+        return Err(image_err(
+            path,
+            format!("colour type {:?}, expected 8-bit grayscale", img.color()),
+        ));
+    }
+    let g = img.into_luma8();
+    Ok((g.width(), g.height(), g.into_raw()))
+}

@@ -1,0 +1,171 @@
+//! The manifest of a scene directory: versioned, self-describing, and self-checking.
+//!
+//! `manifest.json` lists the configuration that produced the scene, the cameras (OpenCV K, R, t)
+//! and lights of every view with their train/test split, every data file with its size and xxh3
+//! hash, and summary statistics. Its own `checksum` (xxh3-64 of the manifest serialised with the
+//! checksum field empty) makes any edit detectable; every listed file is checked on open.
+
+use super::config::SceneConfig;
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Format name in every manifest.
+pub const FORMAT: &str = "neural-brdf-scene";
+/// Current format version.
+pub const VERSION: u32 = 1;
+/// The manifest's file name inside a scene directory.
+pub const MANIFEST_FILE: &str = "manifest.json";
+
+/// Which part of the data a view or light belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Split {
+    /// Used for fitting.
+    Train,
+    /// Used for evaluation.
+    Test,
+}
+
+/// One directional light of a view.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightInfo {
+    /// Unit world direction from the surface towards the light.
+    pub direction: [f32; 3],
+    /// Irradiance, RGB.
+    pub intensity: [f32; 3],
+    /// Split of this light within its view.
+    pub split: Split,
+}
+
+/// One camera view.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ViewInfo {
+    /// Split of the view.
+    pub split: Split,
+    /// Intrinsics K, rows.
+    pub k: [[f32; 3]; 3],
+    /// Rotation R (world to camera), rows.
+    pub r: [[f32; 3]; 3],
+    /// Translation t (x_cam = R x_world + t).
+    pub t: [f32; 3],
+    /// The lights of this view.
+    pub lights: Vec<LightInfo>,
+}
+
+/// A data file of the scene.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FileEntry {
+    /// Path relative to the scene directory.
+    pub path: String,
+    /// Size in bytes.
+    pub bytes: u64,
+    /// xxh3-64 of the contents, hexadecimal.
+    pub xxh3: String,
+}
+
+/// Counts over all (foreground pixel, light) samples.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneStats {
+    /// Foreground pixels over all views.
+    pub foreground_pixels: u64,
+    /// Lit samples (BRDF evaluated).
+    pub lit_samples: u64,
+    /// Shadowed samples.
+    pub shadowed_samples: u64,
+    /// Samples whose light or view is below the shading surface.
+    pub back_facing_samples: u64,
+    /// Samples with a saturated (clipped) channel.
+    pub saturated_samples: u64,
+    /// Lit samples whose ground-truth BRDF is invalid (negative MERL entry).
+    pub invalid_gt_samples: u64,
+    /// saturated / (lit + shadowed + back-facing).
+    pub saturated_fraction: f64,
+}
+
+/// The manifest of a scene directory.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Manifest {
+    /// Always [`FORMAT`].
+    pub format: String,
+    /// Format version, [`VERSION`] when written by this crate.
+    pub version: u32,
+    /// The generator and its version.
+    pub generator: String,
+    /// Provenance label of the data, for example "MERL-derived (NBRDF)".
+    pub label: String,
+    /// The configuration that produced the scene.
+    pub config: SceneConfig,
+    /// The normalised, cleaned mesh inside the directory (binary PLY).
+    pub mesh_file: String,
+    /// Its vertex count.
+    pub mesh_vertices: usize,
+    /// Its triangle count.
+    pub mesh_triangles: usize,
+    /// The views.
+    pub views: Vec<ViewInfo>,
+    /// Every data file.
+    pub files: Vec<FileEntry>,
+    /// Summary statistics.
+    pub stats: SceneStats,
+    /// xxh3-64 of this manifest serialised with `checksum` empty, hexadecimal.
+    pub checksum: String,
+}
+
+/// xxh3-64 of a byte string, as 16 hex digits.
+pub fn hash_hex(bytes: &[u8]) -> String {
+    format!("{:016x}", xxhash_rust::xxh3::xxh3_64(bytes))
+}
+
+impl Manifest {
+    fn body_checksum(&self) -> String {
+        let mut unsigned = self.clone();
+        unsigned.checksum.clear();
+        hash_hex(serde_json::to_string(&unsigned).expect("manifest serialises").as_bytes())
+    }
+
+    /// Serialises the manifest with its checksum filled in.
+    pub fn to_json(&mut self) -> String {
+        self.checksum = self.body_checksum();
+        serde_json::to_string_pretty(self).expect("manifest serialises")
+    }
+
+    /// Reads and checks a manifest: format, version and its own checksum.
+    pub fn read(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let fault = |fault: String| Error::Dataset { path: path.into(), fault };
+        let m: Manifest = serde_json::from_str(&text).map_err(|e| fault(e.to_string()))?;
+        if m.format != FORMAT {
+            return Err(fault(format!("format `{}`, expected `{FORMAT}`", m.format)));
+        }
+        if m.version != VERSION {
+            return Err(fault(format!("format version {}, this build reads {VERSION}", m.version)));
+        }
+        if m.checksum != m.body_checksum() {
+            return Err(fault("checksum mismatch: the manifest was edited or damaged".into()));
+        }
+        Ok(m)
+    }
+
+    /// Checks every listed file (size, then hash) inside `dir`.
+    pub fn verify_files(&self, dir: &Path) -> Result<()> {
+        use rayon::prelude::*;
+        self.files.par_iter().try_for_each(|f| {
+            let path = dir.join(&f.path);
+            let fault = |fault: String| Error::Dataset { path: path.clone(), fault };
+            let bytes = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
+            if bytes.len() as u64 != f.bytes {
+                return Err(fault(format!("{} bytes, the manifest says {}", bytes.len(), f.bytes)));
+            }
+            if hash_hex(&bytes) != f.xxh3 {
+                return Err(fault("contents differ from the manifest's hash".into()));
+            }
+            Ok(())
+        })
+    }
+}

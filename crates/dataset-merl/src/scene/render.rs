@@ -1,0 +1,147 @@
+//! Rendering one (view, light) image of a scene: L = f(l, v) E cos(theta_l) for lit samples, 0
+//! for shadowed and back-facing ones, plus Gaussian noise and saturation (spec section 6).
+//!
+//! Only lit samples evaluate the BRDF: background pixels are not traced, and shadowed or
+//! back-facing samples carry no information about it.
+
+use raycast_precompute::{LightState, ViewPrecompute};
+
+/// Bits of the per-sample flags image.
+pub mod flag {
+    /// The light reaches the point (BRDF evaluated).
+    pub const LIT: u8 = 1;
+    /// The point is in shadow.
+    pub const SHADOWED: u8 = 2;
+    /// Light or view below the shading surface.
+    pub const BACK_FACING: u8 = 4;
+    /// The ground-truth BRDF is valid.
+    pub const GT_VALID: u8 = 8;
+    /// A channel reached the saturation level.
+    pub const SATURATED: u8 = 16;
+}
+
+/// The ground-truth BRDF: local-frame (l, v) to RGB in 1/sr, `None` where invalid.
+pub type GroundTruth<'a> = dyn Fn([f64; 3], [f64; 3]) -> Option<[f64; 3]> + Sync + 'a;
+
+/// One rendered (view, light) image, full frame, row-major.
+pub struct LightImage {
+    /// Observed linear radiance (noise and saturation applied).
+    pub observed: Vec<[f32; 3]>,
+    /// Ground-truth BRDF (1/sr) where lit and valid, else 0.
+    pub brdf: Vec<[f32; 3]>,
+    /// [`flag`] bits per pixel (0 for background).
+    pub flags: Vec<u8>,
+}
+
+/// Noise and saturation settings of a render.
+#[derive(Clone, Copy, Debug)]
+pub struct Sensor {
+    /// Gaussian noise standard deviation per channel.
+    pub noise_sigma: f32,
+    /// Clip level.
+    pub saturation: f32,
+    /// Seed of this image's noise.
+    pub seed: u64,
+}
+
+/// SplitMix64 normal deviates (Box-Muller), deterministic per seed.
+struct Normal {
+    state: u64,
+    spare: Option<f64>,
+}
+
+impl Normal {
+    fn new(seed: u64) -> Self {
+        Self { state: seed, spare: None }
+    }
+    fn uniform(&mut self) -> f64 {
+        self.state = self.state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn sample(&mut self) -> f64 {
+        if let Some(s) = self.spare.take() {
+            return s;
+        }
+        let u1 = self.uniform().max(f64::MIN_POSITIVE);
+        let u2 = self.uniform();
+        let r = (-2.0 * u1.ln()).sqrt();
+        let (s, c) = (std::f64::consts::TAU * u2).sin_cos();
+        self.spare = Some(r * s);
+        r * c
+    }
+}
+
+/// Renders light `light` of a view.
+// Channel loops index several per-channel arrays at once.
+#[allow(clippy::needless_range_loop)]
+pub fn render_light(
+    view: &ViewPrecompute,
+    light: usize,
+    intensity: [f32; 3],
+    gt: &GroundTruth<'_>,
+    sensor: Sensor,
+) -> LightImage {
+    let n_pix = (view.width * view.height) as usize;
+    let mut img = LightImage {
+        observed: vec![[0.0; 3]; n_pix],
+        brdf: vec![[0.0; 3]; n_pix],
+        flags: vec![0; n_pix],
+    };
+    let mut noise = Normal::new(sensor.seed);
+    let l_world = view.lights[light];
+    for k in 0..view.len() {
+        let p = view.pixels[k] as usize;
+        let n = view.normals[k];
+        let frame = angles::Frame::from_normal([n.x as f64, n.y as f64, n.z as f64]);
+        let to_local = |w: glam::Vec3| frame.to_local([w.x as f64, w.y as f64, w.z as f64]);
+        let (l, v) = (to_local(l_world), to_local(view.view_dirs[k]));
+        let mut radiance = [0.0_f64; 3];
+        let mut flags = match view.visibility.get(k, light) {
+            LightState::Lit if l[2] > 0.0 && v[2] > 0.0 => {
+                match gt(l, v) {
+                    Some(f) => {
+                        for c in 0..3 {
+                            radiance[c] = f[c] * intensity[c] as f64 * l[2];
+                            img.brdf[p][c] = f[c] as f32;
+                        }
+                        flag::LIT | flag::GT_VALID
+                    }
+                    None => flag::LIT, // invalid table entry: renders black
+                }
+            }
+            LightState::Shadowed => flag::SHADOWED,
+            _ => flag::BACK_FACING,
+        };
+        let mut saturated = false;
+        for c in 0..3 {
+            let x = radiance[c] + sensor.noise_sigma as f64 * noise.sample();
+            let x = x as f32;
+            if x >= sensor.saturation {
+                saturated = true;
+            }
+            img.observed[p][c] = x.min(sensor.saturation);
+        }
+        if saturated {
+            flags |= flag::SATURATED;
+        }
+        img.flags[p] = flags;
+    }
+    img
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normal_deviates_have_unit_variance() {
+        let mut n = Normal::new(42);
+        let xs: Vec<f64> = (0..200_000).map(|_| n.sample()).collect();
+        let mean = xs.iter().sum::<f64>() / xs.len() as f64;
+        let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / xs.len() as f64;
+        assert!(mean.abs() < 0.01 && (var - 1.0).abs() < 0.01, "{mean} {var}");
+    }
+}
