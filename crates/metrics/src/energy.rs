@@ -1,0 +1,1 @@
+//! Energy conservation (placeholder while building).

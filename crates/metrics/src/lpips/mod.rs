@@ -1,0 +1,1 @@
+//! LPIPS (placeholder while building).

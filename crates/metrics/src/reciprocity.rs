@@ -1,0 +1,1 @@
+//! Reciprocity (placeholder while building).
