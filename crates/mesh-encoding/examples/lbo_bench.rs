@@ -31,6 +31,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--maxf" => {
                 settings.max_basis_factor = it.next().ok_or("--maxf needs a value")?.parse()?
             }
+            "--slice" => settings.slice_size = it.next().ok_or("--slice needs a value")?.parse()?,
             "--tol" => settings.tolerance = it.next().ok_or("--tol needs a value")?.parse()?,
             "--reference" => reference = Some(PathBuf::from(it.next().ok_or("--reference")?)),
             "--dump-mtx" => dump = Some(PathBuf::from(it.next().ok_or("--dump-mtx")?)),

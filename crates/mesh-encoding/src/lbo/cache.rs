@@ -56,8 +56,10 @@ pub fn cache_key(
         bytes.extend_from_slice(&i.to_le_bytes());
     }
     bytes.extend_from_slice(&(k as u64).to_le_bytes());
-    let EigenSettings { block_size, tolerance, max_basis_factor, shift_factor, seed } = *settings;
+    let EigenSettings { block_size, tolerance, max_basis_factor, shift_factor, seed, slice_size } =
+        *settings;
     bytes.extend_from_slice(&(block_size as u64).to_le_bytes());
+    bytes.extend_from_slice(&(slice_size as u64).to_le_bytes());
     for x in [tolerance, max_basis_factor, shift_factor] {
         bytes.extend_from_slice(&x.to_le_bytes());
     }

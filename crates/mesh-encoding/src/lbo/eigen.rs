@@ -66,6 +66,10 @@ pub struct EigenSettings {
     pub shift_factor: f64,
     /// Seed of the random start block (default 0x5eed).
     pub seed: u64,
+    /// Target eigenvalues per slice of the spectrum-slicing solver (`super::slicing`, exact
+    /// eigenvalue counts by inertia); used when `k > 2 * slice_size`. Default 0: off, one shift
+    /// (faster in the measurements so far).
+    pub slice_size: usize,
 }
 
 impl Default for EigenSettings {
@@ -76,6 +80,7 @@ impl Default for EigenSettings {
             max_basis_factor: 6.0,
             shift_factor: -0.01,
             seed: 0x5eed,
+            slice_size: 0,
         }
     }
 }
@@ -218,6 +223,9 @@ pub fn smallest_eigenpairs(
         };
         return Ok((pairs, report));
     }
+    if settings.slice_size > 0 && k > 2 * settings.slice_size {
+        return super::slicing::sliced_eigenpairs(matrices, k, settings);
+    }
 
     // 1. Factor A = L - sigma M.
     let par = faer::get_global_parallelism();
@@ -329,7 +337,7 @@ fn shifted_stiffness(matrices: &LboMatrices, shift: f64) -> Result<SparseColMat<
 /// Householder QR of `w` in place (`w` becomes `Q`), returning `R`. Columns that are (near)
 /// linearly dependent are replaced by random vectors orthogonal to `basis` and to the other
 /// columns, with a zero row in `R`: the Krylov space has become invariant there.
-fn orthonormalize_block(
+pub(crate) fn orthonormalize_block(
     basis: MatRef<'_, f64>,
     mut w: MatMut<'_, f64>,
     rng: &mut SplitMix64,
@@ -438,7 +446,7 @@ fn finish(
 }
 
 /// Sorts eigenpairs by ascending eigenvalue.
-fn sort_pairs(values: Vec<f64>, vectors: Mat<f64>) -> Eigenpairs {
+pub(crate) fn sort_pairs(values: Vec<f64>, vectors: Mat<f64>) -> Eigenpairs {
     let mut order: Vec<usize> = (0..values.len()).collect();
     order.sort_by(|&a, &b| values[a].total_cmp(&values[b]));
     let sorted = Mat::<f64>::from_fn(vectors.nrows(), order.len(), |i, j| vectors[(i, order[j])]);
@@ -474,11 +482,11 @@ pub fn dense_eigenpairs(matrices: &LboMatrices, k: usize) -> Result<Eigenpairs> 
 }
 
 /// Small deterministic generator for the start block (SplitMix64).
-struct SplitMix64(u64);
+pub(crate) struct SplitMix64(pub(crate) u64);
 
 impl SplitMix64 {
     /// Uniform in [-1, 1).
-    fn uniform(&mut self) -> f64 {
+    pub(crate) fn uniform(&mut self) -> f64 {
         self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);

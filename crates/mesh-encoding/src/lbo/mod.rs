@@ -22,6 +22,7 @@ pub mod assembly;
 pub mod cache;
 pub mod eigen;
 pub mod encoding;
+mod slicing;
 
 pub use assembly::LboMatrices;
 pub use cache::{CacheOutcome, cache_key, cached_eigenpairs};
