@@ -11,6 +11,7 @@
 //!   centres at +0.5) and a look-at constructor.
 //! * [`tracer`]: the obvhs CWBVH, closest hit and any hit.
 //! * [`packet`]: any-hit traversal of up to 64 shadow rays sharing one direction at once.
+//! * `packet_closest`: closest-hit traversal of up to 64 camera rays at once (AVX-512, x86-64).
 //! * [`brute_force`]: the f64 all-triangles reference the tracer is tested against.
 //! * [`precompute`]: primary and shadow rays for a scene, skipping background pixels and
 //!   back-facing lights.
@@ -44,6 +45,9 @@ pub mod cache;
 pub mod camera;
 pub mod error;
 pub mod packet;
+#[cfg(target_arch = "x86_64")]
+pub mod packet_closest;
+mod packet_kernels;
 pub mod precompute;
 pub mod scenes;
 pub mod shadows;
@@ -54,11 +58,11 @@ pub use brute_force::BruteForce;
 pub use cache::{CacheOutcome, FORMAT_VERSION, cache_key, cache_path, precompute_cached};
 pub use camera::{Camera, intrinsics, mat3_from_rows};
 pub use error::{Error, Result};
+pub use packet::PACKET_SIZE;
 pub use precompute::{
     PrecomputeSettings, ScenePrecompute, ShadowBias, TraceStats, View, ViewPrecompute, precompute,
     precompute_with_tracer, precompute_with_traversal,
 };
 pub use shadows::Traversal;
-pub use packet::PACKET_SIZE;
 pub use tracer::{Hit, Tracer};
 pub use visibility::{LightState, Visibility};

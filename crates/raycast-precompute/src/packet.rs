@@ -2,69 +2,104 @@
 //! of one directional light): up to 64 rays, one bit each, walk the tree together.
 //!
 //! Per visited node the quantised child boxes are decoded once for the whole packet and each child
-//! box is tested against 4 rays at a time (SSE through glam's `Vec4`); leaf triangles are then
-//! tested, one by one, only for the rays whose box tests reached them.
+//! box is tested against many rays at once: 16 with AVX-512 where the CPU has it (detected at run
+//! time), else 4 (SSE through glam's `Vec4`). Leaf triangles are then tested only for the rays
+//! whose box tests reached them.
 //!
 //! The result is bit-identical to tracing each ray alone with obvhs's `ray_traverse_miss`
 //! ([`crate::Tracer::occluded`] with `t_max = inf`): a ray's box tests use the same f32
 //! operations in the same order as `CwBvhNode::intersect_ray` (the product of quantised plane and
-//! scaled inverse direction, rounded, plus the ray's scaled origin offset, rounded; max/min in the
-//! same argument order; `t_min` clamped to obvhs's node epsilon), a ray reaches exactly the leaves
-//! it would reach alone, and its triangles are tested with the same `RtTriangle::intersect` on
-//! the same `Ray`. An any-hit query with a fixed `t_max` does not depend on the traversal order,
-//! so the packet's order (front to back for the shared direction) changes only the speed.
+//! scaled inverse direction, rounded, plus the ray's scaled origin offset, rounded; max/min with
+//! the same operands; `t_min` clamped to obvhs's node epsilon), a ray reaches exactly the leaves
+//! it would reach alone, and its triangles are tested with the same arithmetic as
+//! `RtTriangle::intersect` (see [`crate::packet_kernels`]). An any-hit query with a fixed `t_max`
+//! does not depend on the traversal order, so the packet's order (front to back for the shared
+//! direction) changes only the speed.
 
-use glam::{Vec3, Vec3A, Vec4};
+use glam::{Vec3, Vec3A};
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::Ray;
 use obvhs::rt_triangle::RtTriangle;
 
+use crate::packet_kernels::{Kernel, Soa, SseKernel};
+
 /// Most rays in one packet (one bit each of a `u64`).
 pub const PACKET_SIZE: usize = 64;
-
-/// obvhs 0.4's `cwbvh::node::EPSILON` (crate-private there): node box tests clamp the ray's
-/// entry distance to at least this.
-const NODE_EPSILON: f32 = 0.0001;
-
-/// Groups of 4 rays in a full packet.
-const GROUPS: usize = PACKET_SIZE / 4;
 
 /// Traversal stack size: obvhs keeps CWBVHs below depth 32 and a node pushes at most 8 children.
 const STACK: usize = 8 * 32;
 
+/// The packet's shared data: the rays (origins as SoA), the shared direction and its inverse.
+pub(crate) struct Packet {
+    /// The rays one by one (as obvhs would build them), for scalar triangle tests.
+    pub rays: [Ray; PACKET_SIZE],
+    /// Origins, structure of arrays.
+    pub origin: Soa,
+    /// The shared direction (no -0.0 components).
+    pub dir: Vec3A,
+    /// obvhs's safe inverse of `dir`.
+    pub inv: Vec3A,
+    /// Whether each direction component is negative (which quantised plane is entered first).
+    pub neg: [bool; 3],
+    /// Number of rays.
+    pub len: usize,
+}
+
 /// Occlusion of up to [`PACKET_SIZE`] rays `origins[i] + t dir`, `t in [0, inf)`: bit `i` of the
 /// result is set when ray `i` hits a triangle. `dir` must already have its -0.0 components turned
-/// into +0.0 (see `tracer::positive_zeros`).
+/// into +0.0 (see `tracer::positive_zeros`). `allow_avx512: false` forces the SSE kernels.
 ///
 /// # Panics
 /// If more than [`PACKET_SIZE`] origins are given.
-pub(crate) fn occluded_packet(bvh: &CwBvh, tris: &[RtTriangle], dir: Vec3A, origins: &[Vec3]) -> u64 {
+pub(crate) fn occluded_packet(
+    bvh: &CwBvh,
+    tris: &[RtTriangle],
+    dir: Vec3A,
+    origins: &[Vec3],
+    allow_avx512: bool,
+) -> u64 {
     let n = origins.len();
     assert!(n <= PACKET_SIZE, "{n} rays in one packet, at most {PACKET_SIZE}");
     if n == 0 || bvh.nodes.is_empty() {
         return 0;
     }
     let proto = Ray::new(Vec3A::ZERO, dir, 0.0, f32::INFINITY);
-    let inv = proto.inv_direction;
-    let inv4 = [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)];
-    let ray_tmax = Vec4::splat(proto.tmax);
-    let eps = Vec4::splat(NODE_EPSILON);
-    let neg = [dir.x < 0.0, dir.y < 0.0, dir.z < 0.0];
-    let octant = (u8::from(neg[0]) << 2) | (u8::from(neg[1]) << 1) | u8::from(neg[2]);
-
-    // The rays (for the triangle tests) and their origins as 4-ray groups (for the box tests).
-    let mut rays = [proto; PACKET_SIZE];
-    let mut org = [[Vec4::ZERO; 3]; GROUPS];
+    let mut packet = Packet {
+        rays: [proto; PACKET_SIZE],
+        origin: Soa::default(),
+        dir,
+        inv: proto.inv_direction,
+        neg: [dir.x < 0.0, dir.y < 0.0, dir.z < 0.0],
+        len: n,
+    };
     for (i, o) in origins.iter().enumerate() {
-        rays[i].origin = Vec3A::from(*o);
-        org[i / 4][0][i % 4] = o.x;
-        org[i / 4][1][i % 4] = o.y;
-        org[i / 4][2][i % 4] = o.z;
+        packet.rays[i].origin = Vec3A::from(*o);
+        for a in 0..3 {
+            packet.origin.0[a][i] = o[a];
+        }
     }
-    let groups = n.div_ceil(4);
-    let all = if n == PACKET_SIZE { u64::MAX } else { (1u64 << n) - 1 };
-    let mut alive = all; // rays not yet found occluded
+    #[cfg(target_arch = "x86_64")]
+    if allow_avx512 && crate::packet_kernels::has_avx512() {
+        // SAFETY: the CPU supports AVX-512F (checked just above).
+        return unsafe { crate::packet_kernels::traverse_avx512(bvh, tris, &packet) };
+    }
+    let _ = allow_avx512;
+    // SAFETY: the SSE kernels need only SSE2 (part of x86-64) or nothing (glam's scalar code).
+    unsafe { traverse::<SseKernel>(bvh, tris, &packet) }
+}
 
+/// The packet traversal with box and triangle kernels `K`; returns the occluded rays' bits.
+///
+/// # Safety
+/// The CPU must support `K`'s target features.
+#[inline(always)]
+pub(crate) unsafe fn traverse<K: Kernel>(bvh: &CwBvh, tris: &[RtTriangle], packet: &Packet) -> u64 {
+    let n = packet.len;
+    let all = if n == PACKET_SIZE { u64::MAX } else { (1u64 << n) - 1 };
+    let octant =
+        (u8::from(packet.neg[0]) << 2) | (u8::from(packet.neg[1]) << 1) | u8::from(packet.neg[2]);
+    let mut alive = all; // rays not yet found occluded
+    let mut scratch = Soa::default();
     let mut stack = [(0u32, 0u64); STACK];
     stack[0] = (0, all);
     let mut len = 1;
@@ -76,84 +111,50 @@ pub(crate) fn occluded_packet(bvh: &CwBvh, tris: &[RtTriangle], dir: Vec3A, orig
             continue;
         }
         let node = &bvh.nodes[index as usize];
-        // obvhs: adjusted_ray_dir_inv = extent * inv_dir; adjusted_ray_origin = (p - o) * inv_dir.
-        let adj_inv = node.compute_extent() * inv;
-        let p = Vec3A::from(node.p);
-        let mut adj_org = [[Vec4::ZERO; 3]; GROUPS];
-        for g in 0..groups {
-            if (active >> (4 * g)) & 0xf != 0 {
-                for a in 0..3 {
-                    adj_org[g][a] = (Vec4::splat(p[a]) - org[g][a]) * inv4[a];
-                }
-            }
-        }
+        // SAFETY: the caller vouches for K's target features.
+        let hits = unsafe { K::node_hits(node, packet, active, &mut scratch) };
         // Internal children reached, with their traversal key (obvhs's order: ascending
         // slot ^ octant).
         let mut inner: [(u8, u32, u64); 8] = [(0, 0, 0); 8];
         let mut inner_len = 0;
-        for c in 0..8 {
-            let meta = node.child_meta[c];
-            if meta == 0 {
-                continue; // empty slot
-            }
-            let q = |lo: &[u8; 8], hi: &[u8; 8], a: usize| {
-                let (near, far) = if neg[a] { (hi[c], lo[c]) } else { (lo[c], hi[c]) };
-                (near as f32 * adj_inv[a], far as f32 * adj_inv[a])
-            };
-            let (x0, x1) = q(&node.child_min_x, &node.child_max_x, 0);
-            let (y0, y1) = q(&node.child_min_y, &node.child_max_y, 1);
-            let (z0, z1) = q(&node.child_min_z, &node.child_max_z, 2);
-            let (x0, x1) = (Vec4::splat(x0), Vec4::splat(x1));
-            let (y0, y1) = (Vec4::splat(y0), Vec4::splat(y1));
-            let (z0, z1) = (Vec4::splat(z0), Vec4::splat(z1));
-            let mut hits = 0u64;
-            for g in 0..groups {
-                if (active >> (4 * g)) & 0xf == 0 {
-                    continue;
-                }
-                let [ox, oy, oz] = adj_org[g];
-                let tmin = (x0 + ox).max((y0 + oy).max(z0 + oz)).max(eps);
-                let tmax = (x1 + ox).min((y1 + oy).min(z1 + oz)).min(ray_tmax);
-                hits |= u64::from(tmin.cmple(tmax).bitmask()) << (4 * g);
-            }
-            hits &= active;
-            if hits == 0 {
+        for (c, &rays) in hits.iter().enumerate() {
+            if rays == 0 {
                 continue;
             }
+            let meta = node.child_meta[c];
             // Internal children have meta 001s_sss + 24 (bits 3 and 4 set), leaves never do.
             if meta & 0b1_1000 == 0b1_1000 {
                 let slot = u32::from(meta & 0b1_1111) - 24;
                 let child = node.child_base_idx
                     + (u32::from(node.imask) & !(u32::MAX << slot)).count_ones();
-                inner[inner_len] = ((slot as u8) ^ octant, child, hits);
+                inner[inner_len] = ((slot as u8) ^ octant, child, rays);
                 inner_len += 1;
             } else {
                 let first = node.primitive_base_idx + u32::from(meta & 0b1_1111);
                 let count = (meta & 0b1110_0000).count_ones();
                 for prim in first..first + count {
-                    let tri = &tris[prim as usize];
-                    let mut todo = hits & alive;
-                    while todo != 0 {
-                        let i = todo.trailing_zeros() as usize;
-                        todo &= todo - 1;
-                        if tri.intersect(&rays[i]) < proto.tmax {
-                            alive &= !(1u64 << i);
-                        }
+                    let todo = rays & alive;
+                    if todo == 0 {
+                        break;
                     }
-                }
-                if active & alive == 0 {
-                    break;
+                    // SAFETY: as above.
+                    alive &= !unsafe { K::triangle_hits(&tris[prim as usize], packet, todo) };
                 }
             }
         }
         if alive == 0 {
             break;
         }
-        // Push so that the lowest key is popped first.
-        let inner = &mut inner[..inner_len];
-        inner.sort_unstable_by(|a, b| b.0.cmp(&a.0));
-        for &(_, child, hits) in inner.iter() {
-            stack[len] = (child, hits);
+        // Push so that the lowest key is popped first (insertion sort, descending).
+        for i in 1..inner_len {
+            let mut j = i;
+            while j > 0 && inner[j - 1].0 < inner[j].0 {
+                inner.swap(j - 1, j);
+                j -= 1;
+            }
+        }
+        for &(_, child, rays) in &inner[..inner_len] {
+            stack[len] = (child, rays);
             len += 1;
         }
     }

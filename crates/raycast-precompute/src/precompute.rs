@@ -17,9 +17,9 @@ use rayon::prelude::*;
 
 use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::tracer::Tracer;
+use crate::shadows::{TILE, Traversal, tile_rows, trace_shadows};
+use crate::tracer::{Hit, Tracer};
 use crate::visibility::Visibility;
-use crate::shadows::{Traversal, trace_shadows};
 
 /// One view of a scene: a camera, its light directions and an optional foreground mask.
 #[derive(Debug, Clone, PartialEq)]
@@ -251,29 +251,63 @@ fn trace_view(
         Some(mask) => (0..mask.len() as u32).filter(|&i| mask[i as usize]).collect(),
         None => (0..cam.pixel_count() as u32).collect(),
     };
-    let hits: Vec<PixelHit> = candidates
-        .par_iter()
-        .filter_map(|&pixel| {
-            let (origin, dir) = cam.pixel_ray(pixel as usize);
-            let hit = tracer.closest_hit(origin, dir, f32::INFINITY)?;
-            let [b1, b2] = hit.barycentrics;
-            let tri = mesh.triangles[hit.triangle as usize];
-            let [v0, v1, v2] = mesh.corners(hit.triangle as usize);
-            let position = (1.0 - b1 - b2) * v0 + b1 * v1 + b2 * v2;
-            let geometric = (v1 - v0).cross(v2 - v0).normalize_or(Vec3::Z);
-            let facing = if geometric.dot(dir) > 0.0 { -geometric } else { geometric };
-            let n = tri.map(|i| vertex_normals[i as usize]);
-            Some(PixelHit {
-                pixel,
-                triangle: hit.triangle,
-                barycentrics: hit.barycentrics,
-                position,
-                normal: interpolate_normal(n, b1, b2, facing),
-                view_dir: -dir,
-                shadow_origin: position + bias * facing,
+    let shade = |pixel: u32, dir: Vec3, hit: Hit| {
+        let [b1, b2] = hit.barycentrics;
+        let tri = mesh.triangles[hit.triangle as usize];
+        let [v0, v1, v2] = mesh.corners(hit.triangle as usize);
+        let position = (1.0 - b1 - b2) * v0 + b1 * v1 + b2 * v2;
+        let geometric = (v1 - v0).cross(v2 - v0).normalize_or(Vec3::Z);
+        let facing = if geometric.dot(dir) > 0.0 { -geometric } else { geometric };
+        let n = tri.map(|i| vertex_normals[i as usize]);
+        PixelHit {
+            pixel,
+            triangle: hit.triangle,
+            barycentrics: hit.barycentrics,
+            position,
+            normal: interpolate_normal(n, b1, b2, facing),
+            view_dir: -dir,
+            shadow_origin: position + bias * facing,
+        }
+    };
+    let hits: Vec<PixelHit> = match traversal {
+        Traversal::OneByOne => candidates
+            .par_iter()
+            .filter_map(|&pixel| {
+                let (origin, dir) = cam.pixel_ray(pixel as usize);
+                let hit = tracer.closest_hit(origin, dir, f32::INFINITY)?;
+                Some(shade(pixel, dir, hit))
             })
-        })
-        .collect();
+            .collect(),
+        Traversal::Packets => {
+            // Rows of 8 x 8 tiles in parallel, each tile's camera rays traced as packets.
+            let rows: Vec<Vec<PixelHit>> = tile_rows(&candidates, cam.width, TILE)
+                .par_iter()
+                .map(|row| {
+                    let mut out = Vec::new();
+                    let (mut origins, mut dirs, mut found) = (Vec::new(), Vec::new(), Vec::new());
+                    for tile in row {
+                        (origins.clear(), dirs.clear());
+                        for &pixel in tile {
+                            let (o, d) = cam.pixel_ray(pixel as usize);
+                            origins.push(o);
+                            dirs.push(d);
+                        }
+                        found.clear();
+                        found.resize(tile.len(), None);
+                        tracer.closest_hits(&origins, &dirs, &mut found);
+                        for ((&pixel, &dir), hit) in tile.iter().zip(&dirs).zip(&found) {
+                            if let Some(hit) = hit {
+                                out.push(shade(pixel, dir, *hit));
+                            }
+                        }
+                    }
+                    out.sort_unstable_by_key(|h| h.pixel);
+                    out
+                })
+                .collect();
+            rows.into_iter().flatten().collect()
+        }
+    };
 
     let origins: Vec<Vec3> = hits.iter().map(|h| h.shadow_origin).collect();
     let normals: Vec<Vec3> = hits.iter().map(|h| h.normal).collect();

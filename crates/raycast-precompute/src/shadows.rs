@@ -95,9 +95,26 @@ fn tiles(pixels: &[u32], width: u32) -> Vec<Vec<u32>> {
     let tile_of = |p: u32| (p / width / TILE) * tiles_x + (p % width) / TILE;
     let mut order: Vec<u32> = (0..pixels.len() as u32).collect();
     order.sort_by_key(|&k| tile_of(pixels[k as usize])); // stable: row-major within a tile
-    order.chunk_by(|&a, &b| tile_of(pixels[a as usize]) == tile_of(pixels[b as usize]))
+    order
+        .chunk_by(|&a, &b| tile_of(pixels[a as usize]) == tile_of(pixels[b as usize]))
         .map(<[u32]>::to_vec)
         .collect()
+}
+
+/// Row-major pixel indices (increasing) grouped into rows of `tile x tile` image tiles: one entry
+/// per row of tiles, holding its non-empty tiles left to right, each tile's pixels row-major.
+pub(crate) fn tile_rows(pixels: &[u32], width: u32, tile: u32) -> Vec<Vec<Vec<u32>>> {
+    let mut rows: Vec<Vec<Vec<u32>>> = Vec::new();
+    for band in pixels.chunk_by(|&a, &b| a / width / tile == b / width / tile) {
+        let mut tiles: Vec<Vec<u32>> = Vec::new();
+        let mut order = band.to_vec();
+        order.sort_by_key(|&p| (p % width) / tile); // stable: row-major within a tile
+        for t in order.chunk_by(|&a, &b| (a % width) / tile == (b % width) / tile) {
+            tiles.push(t.to_vec());
+        }
+        rows.push(tiles);
+    }
+    rows
 }
 
 fn packets(

@@ -24,10 +24,11 @@ fn packets_match_one_by_one_on_real_meshes() {
         let packets =
             precompute_with_traversal(&tracer, &views, &settings, Traversal::Packets).unwrap();
         // Enough of every state for the comparison to mean something.
-        let (lit, shadowed, back) =
-            simple.views.iter().map(|v| v.visibility.counts()).fold((0, 0, 0), |a, c| {
-                (a.0 + c.0, a.1 + c.1, a.2 + c.2)
-            });
+        let (lit, shadowed, back) = simple
+            .views
+            .iter()
+            .map(|v| v.visibility.counts())
+            .fold((0, 0, 0), |a, c| (a.0 + c.0, a.1 + c.1, a.2 + c.2));
         println!("{name}: lit {lit}, shadowed {shadowed}, back-facing {back}");
         assert!(lit > 10_000 && shadowed > 1_000 && back > 1_000, "{name}");
         assert_eq!(simple.stats, packets.stats, "{name}");
@@ -63,6 +64,7 @@ fn single_packets_match_per_ray_queries() {
                 })
                 .collect();
             let mask = tracer.occluded_packet(dir, &origins);
+            assert_eq!(mask, tracer.occluded_packet_portable(dir, &origins), "SSE vs AVX-512");
             for (i, o) in origins.iter().enumerate() {
                 let alone = tracer.occluded(*o, dir, f32::INFINITY);
                 assert_eq!(mask & (1 << i) != 0, alone, "ray {i} of {n}, dir {dir}, origin {o}");
