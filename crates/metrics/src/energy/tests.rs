@@ -1,5 +1,7 @@
 //! Tests of the energy-conservation estimators.
 
+#![allow(clippy::needless_range_loop)]
+
 use super::*;
 use crate::batch::{AnalyticBatch, FnBatch};
 use brdf_analytic::{Lambert, LambertParams, TorranceSparrow, TorranceSparrowParams};
@@ -59,7 +61,9 @@ fn estimators_agree_on_a_glossy_model() {
             let rs = reference.std_error[c];
             assert!((s.energy[c] - r).abs() <= 4.0 * (s.std_error[c] + rs), "mc {k} {c}");
             assert!((q.energy[c] - r).abs() <= 4.0 * (q.std_error[c] + rs) + 1e-4, "qmc {k} {c}");
-            assert!(q.std_error[c] <= 1e-3 + 1e-12 || q.evaluations == 8 * 2048);
+            let settled =
+                q.std_error[c] <= 1e-3 + 1e-12 || q.energy[c] + 4.0 * q.std_error[c] < 1.0;
+            assert!(settled || q.evaluations == 8 * 2048);
         }
     }
     assert!(quick.evaluations < slow.evaluations, "{} vs {}", quick.evaluations, slow.evaluations);
