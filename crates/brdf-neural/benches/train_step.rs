@@ -7,9 +7,25 @@
 //! Environment: `BRDF_BENCH_BATCH` (default 32768), `BRDF_BENCH_BACKENDS` (default: every
 //! backend compiled in, e.g. `flex,ndarray`).
 //!
-//! After the criterion groups a summary prints samples/s and the achieved GFLOP/s of each step
+//! Criterion's filter (e.g. `-- single_mlp`) selects the criterion groups only; the summary
+//! always times every model. After the criterion groups a summary prints samples/s and the achieved GFLOP/s of each step
 //! (matrix-multiply FLOPs of the model: 2 m n k per product, forward 1x and backward 2x),
 //! against the matmul rate of a [32768, 128] x [128, 128] product on the same backend.
+//!
+//! Measured (2-core AMD EPYC with AVX-512, burn 0.22.1, `x86-v4` on; the machine was NOT quiet:
+//! load average 4 to 7 from other builds and benches, so absolute figures are 2 to 4 times
+//! slower than on a quiet machine and vary by +-30 % between runs). Step time in ms:
+//!
+//! | model | flex | ndarray | PyTorch 2.15 CPU, 2 threads (same runs) |
+//! | --- | ---: | ---: | ---: |
+//! | Single MLP (mapping, 114,691 params) | 540-785 | 1,064-1,137 | 833-2,229 (median of 10 steps, 4 runs) |
+//! | Enh. Add. Shared | 748-1,533 | 1,658-2,667 | |
+//! | Disney | 342-580 | 1,253-1,539 | |
+//!
+//! flex beat ndarray by 1.4x to 3.7x in every pair of runs, and its Single MLP step was
+//! 0.6x-0.9x PyTorch's measured back to back; a ratio taken under such load is not a reliable
+//! figure. The "matmul GFLOP/s" column is not a peak: under contention the isolated product
+//! runs slower than the products inside a step (fractions above 1).
 
 use brdf_neural::device::Backend;
 use brdf_neural::mlp::MlpConfig;
@@ -107,7 +123,8 @@ fn matmul_gflops(device: &Device, n: usize) -> f64 {
     let b = Tensor::<2>::random([128, 128], Distribution::Uniform(-1.0, 1.0), device);
     let run = || {
         let c = a.clone().matmul(b.clone());
-        let _ = c.into_data();
+        device.sync().expect("sync");
+        drop(c);
     };
     run();
     let reps = 20;
