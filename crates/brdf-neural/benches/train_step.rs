@@ -22,9 +22,9 @@
 //! | Enh. Add. Shared | 748-1,533 | 1,658-2,667 | |
 //! | Disney | 342-580 | 1,253-1,539 | |
 //!
-//! flex beat ndarray by 1.4x to 3.7x in every pair of runs, and its Single MLP step was
-//! 0.6x-0.9x PyTorch's measured back to back; a ratio taken under such load is not a reliable
-//! figure. The "matmul GFLOP/s" column is not a peak: under contention the isolated product
+//! flex beat ndarray by 1.4x to 3.7x in every pair of runs. The Single MLP step time over
+//! PyTorch's, measured back to back, ranged from 0.3 to 1.4 (mostly below 1) as the load
+//! changed: a ratio taken under such load is not a reliable figure. The "matmul GFLOP/s" column is not a peak: under contention the isolated product
 //! runs slower than the products inside a step (fractions above 1).
 
 use brdf_neural::device::Backend;
