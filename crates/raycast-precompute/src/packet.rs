@@ -31,8 +31,6 @@ const STACK: usize = 8 * 32;
 
 /// The packet's shared data: the rays (origins as SoA), the shared direction and its inverse.
 pub(crate) struct Packet {
-    /// The rays one by one (as obvhs would build them), for scalar triangle tests.
-    pub rays: [Ray; PACKET_SIZE],
     /// Origins, structure of arrays.
     pub origin: Soa,
     /// The shared direction (no -0.0 components).
@@ -65,7 +63,6 @@ pub(crate) fn occluded_packet(
     }
     let proto = Ray::new(Vec3A::ZERO, dir, 0.0, f32::INFINITY);
     let mut packet = Packet {
-        rays: [proto; PACKET_SIZE],
         origin: Soa::default(),
         dir,
         inv: proto.inv_direction,
@@ -73,7 +70,6 @@ pub(crate) fn occluded_packet(
         len: n,
     };
     for (i, o) in origins.iter().enumerate() {
-        packet.rays[i].origin = Vec3A::from(*o);
         for a in 0..3 {
             packet.origin.0[a][i] = o[a];
         }

@@ -120,8 +120,8 @@ pub(crate) unsafe fn closest_packet(
         let mut leaves: [(u8, u8, u64); 8] = [(0, 0, 0); 8];
         let mut inner: [(u8, u32, u64); 8] = [(0, 0, 0); 8];
         let (mut n_leaves, mut n_inner) = (0, 0);
-        for c in 0..8 {
-            let rays_c = child_rays[c] & active;
+        for (c, &rays_c) in child_rays.iter().enumerate() {
+            let rays_c = rays_c & active;
             let meta = node.child_meta[c];
             if rays_c == 0 {
                 continue;

@@ -9,6 +9,7 @@
 
 use glam::{Vec3A, Vec4};
 use obvhs::cwbvh::node::CwBvhNode;
+use obvhs::ray::Ray;
 use obvhs::rt_triangle::RtTriangle;
 
 use crate::packet::{PACKET_SIZE, Packet};
@@ -122,8 +123,17 @@ impl Kernel for SseKernel {
         while todo != 0 {
             let i = todo.trailing_zeros() as usize;
             todo &= todo - 1;
+            // The ray as obvhs's Ray::new(origin, dir, 0, inf) builds it.
+            let [x, y, z] = &packet.origin.0;
+            let ray = Ray {
+                origin: Vec3A::new(x[i], y[i], z[i]),
+                direction: packet.dir,
+                inv_direction: packet.inv,
+                tmin: 0.0,
+                tmax: f32::INFINITY,
+            };
             // obvhs's ray_traverse_miss counts a hit when intersect(..) < ray.tmax.
-            if tri.intersect(&packet.rays[i]) < f32::INFINITY {
+            if tri.intersect(&ray) < f32::INFINITY {
                 hits |= 1u64 << i;
             }
         }

@@ -286,7 +286,8 @@ fn trace_view(
                     let mut out = Vec::new();
                     let (mut origins, mut dirs, mut found) = (Vec::new(), Vec::new(), Vec::new());
                     for tile in row {
-                        (origins.clear(), dirs.clear());
+                        origins.clear();
+                        dirs.clear();
                         for &pixel in tile {
                             let (o, d) = cam.pixel_ray(pixel as usize);
                             origins.push(o);

@@ -79,3 +79,35 @@ fn single_packets_match_per_ray_queries() {
     assert!(occluded > total / 10 && occluded < total * 9 / 10, "{occluded} of {total}");
     assert_eq!(tracer.occluded_packet(Vec3::Z, &[]), 0);
 }
+
+#[test]
+fn batched_closest_hits_match_closest_hit() {
+    let Some(mesh) = common::shared_mesh("spot.obj") else { return };
+    let tracer = Tracer::new(&mesh);
+    let mut rng = Rng(23);
+    // Camera rays of a tile-like bundle, plus random rays of every octant (some with -0.0).
+    let mut origins = Vec::new();
+    let mut dirs = Vec::new();
+    let eye = Vec3::new(0.3, -2.4, 0.9);
+    for i in 0..150 {
+        let target = Vec3::new(0.01 * (i % 12) as f32 - 0.06, 0.0, 0.01 * (i / 12) as f32 - 0.06);
+        origins.push(eye);
+        dirs.push((target - eye).normalize());
+    }
+    for _ in 0..300 {
+        let o = 1.8 * rng.direction();
+        origins.push(o);
+        dirs.push((0.5 * rng.direction() - o).normalize());
+    }
+    origins.extend([Vec3::new(0.1, 0.05, 3.0), Vec3::new(0.02, 3.0, 0.1)]);
+    dirs.extend([Vec3::new(-0.0, 0.0, -1.0), Vec3::new(0.0, -1.0, -0.0)]);
+    let mut batched = vec![None; dirs.len()];
+    tracer.closest_hits(&origins, &dirs, &mut batched);
+    let mut hits = 0;
+    for (i, got) in batched.iter().enumerate() {
+        let alone = tracer.closest_hit(origins[i], dirs[i], f32::INFINITY);
+        assert_eq!(*got, alone, "ray {i}");
+        hits += usize::from(alone.is_some());
+    }
+    assert!(hits > 150 && hits < dirs.len() - 20, "{hits}");
+}
