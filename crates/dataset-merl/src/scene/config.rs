@@ -39,6 +39,7 @@ pub enum MaterialSpec {
 /// | `saturation` | 2.0 | observed values are clipped here; such pixels are flagged saturated |
 /// | `lookup` | nearest-lower | MERL lookup rule |
 /// | `shadow_bias_relative` | 1e-4 | shadow-ray offset as a fraction of the mesh diagonal |
+/// | `up_axis` | y | the mesh's up axis; the mesh is rotated so that it points to +z, the orbit's up |
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SceneSettings {
@@ -68,6 +69,19 @@ pub struct SceneSettings {
     pub lookup: Lookup,
     /// Shadow bias relative to the mesh diagonal.
     pub shadow_bias_relative: f32,
+    /// The mesh's up axis (the common test meshes are y-up).
+    pub up_axis: UpAxis,
+}
+
+/// Which mesh axis points up.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum UpAxis {
+    /// +y up (OBJ convention of most test meshes): rotated by +90 degrees about x.
+    #[default]
+    Y,
+    /// +z up: used as is.
+    Z,
 }
 
 impl Default for SceneSettings {
@@ -87,6 +101,7 @@ impl Default for SceneSettings {
             saturation: 2.0,
             lookup: Lookup::NearestLower,
             shadow_bias_relative: 1e-4,
+            up_axis: UpAxis::Y,
         }
     }
 }

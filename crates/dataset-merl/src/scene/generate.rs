@@ -11,6 +11,7 @@
 //! | `images/vVV_lLL.exr` | observed linear HDR radiance, RGB float |
 //! | `brdf/vVV_lLL.exr` | ground-truth BRDF (1/sr) where lit and valid, else 0 |
 //! | `flags/vVV_lLL.png` | per-pixel [`flag`](super::render::flag) bits (lit, shadowed, back-facing, GT valid, saturated) |
+//! | `previews/vVV.png` | sRGB preview of view VV under its first light, for looking at |
 //! | `geometry/` | the ray-casting precompute, content-keyed cache (rebuilt if damaged) |
 //!
 //! The directory is assembled under a temporary name beside the target and renamed into place
@@ -96,7 +97,13 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
     }
     let s = &config.settings;
     let options = mesh_encoding::LoadOptions { cleanup: true, normalize_unit_sphere: true };
-    let mesh = mesh_encoding::load_mesh(&config.mesh, &options)?.mesh;
+    let mut mesh = mesh_encoding::load_mesh(&config.mesh, &options)?.mesh;
+    if s.up_axis == super::config::UpAxis::Y {
+        // Rotation by +90 degrees about x: (x, y, z) -> (x, -z, y) sends +y to +z.
+        for p in &mut mesh.positions {
+            *p = Vec3::new(p.x, -p.z, p.y);
+        }
+    }
 
     let (label, gt): (String, Box<GroundTruth<'static>>) = match &config.material {
         MaterialSpec::Merl { name } => {
@@ -142,7 +149,7 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
     let name = out.file_name().and_then(|n| n.to_str()).unwrap_or("scene");
     let tmp = out.with_file_name(format!(".{name}.partial-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&tmp);
-    for sub in ["images", "brdf", "flags", "masks"] {
+    for sub in ["images", "brdf", "flags", "masks", "previews"] {
         std::fs::create_dir_all(tmp.join(sub)).map_err(|e| Error::io(tmp.join(sub), e))?;
     }
     let result = (|| {
@@ -206,6 +213,11 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
             let rel = format!("flags/{stem}.png");
             images::write_png_gray(&tmp.join(&rel), vp.width, vp.height, &img.flags)?;
             out_files.push(rel);
+            if li == 0 {
+                let rel = format!("previews/v{vi:02}.png");
+                images::write_png_srgb(&tmp.join(&rel), vp.width, vp.height, &img.observed)?;
+                out_files.push(rel);
+            }
             let mut entries = Vec::with_capacity(3);
             for rel in out_files {
                 let path = tmp.join(&rel);

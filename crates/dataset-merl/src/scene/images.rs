@@ -70,3 +70,17 @@ pub fn read_png_gray(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
     let g = img.into_luma8();
     Ok((g.width(), g.height(), g.into_raw()))
 }
+
+/// The sRGB OETF (IEC 61966-2-1) of a linear value clamped to [0, 1], as an 8-bit code.
+pub fn srgb8(linear: f32) -> u8 {
+    let c = linear.clamp(0.0, 1.0);
+    let s = if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
+    (s * 255.0 + 0.5) as u8
+}
+
+/// Writes a linear RGB image as an 8-bit sRGB PNG (values clamped to [0, 1]), for viewing.
+pub fn write_png_srgb(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<()> {
+    let bytes: Vec<u8> = rgb.iter().flat_map(|p| p.map(srgb8)).collect();
+    image::save_buffer(path, &bytes, width, height, image::ExtendedColorType::Rgb8)
+        .map_err(|e| image_err(path, e))
+}

@@ -17,7 +17,7 @@ pub mod manifest;
 pub mod mesh_file;
 pub mod render;
 
-pub use config::{MaterialSpec, SceneConfig, SceneSettings};
+pub use config::{MaterialSpec, SceneConfig, SceneSettings, UpAxis};
 pub use dataset::{SampleSet, SceneDataset};
 pub use generate::{GenerateReport, generate_scene};
 pub use manifest::{Manifest, Split};
