@@ -1,0 +1,113 @@
+//! Checkpoints: model weights and Adam state (burnpack, through burn's records, which keep
+//! the parameter ids the optimizer state is keyed by), plus the step, the curve so far and the
+//! elapsed time. The batch RNG needs no state: step `s` draws from a generator seeded with
+//! `seed + s`, so a resumed run is identical to an uninterrupted one.
+//!
+//! A checkpoint is written into a temporary folder and renamed into place; older checkpoints
+//! are removed only after the new one is complete, so a crash or a non-finite loss always
+//! leaves the last good one.
+
+use crate::run_dir::{CHECKPOINTS_DIR, CurveRow};
+use crate::{Error, Result};
+use brdf_neural::BrdfModel;
+use burn::module::Module;
+use burn::optim::ModuleOptimizer;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+const MODEL: &str = "model.bpk";
+const OPTIM: &str = "optim.bpk";
+const STATE: &str = "state.json";
+
+/// What a checkpoint holds besides the tensors.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CheckpointState {
+    /// Steps done.
+    pub step: u64,
+    /// The training curve so far.
+    pub curve: Vec<CurveRow>,
+    /// Training wall time so far, seconds.
+    pub seconds: f64,
+}
+
+/// Folder of the checkpoint after `step` steps.
+pub fn checkpoint_dir(run: &Path, step: u64) -> PathBuf {
+    run.join(CHECKPOINTS_DIR).join(format!("step-{step:09}"))
+}
+
+/// Writes a checkpoint atomically and removes the older ones; returns its folder.
+pub fn save(
+    run: &Path,
+    model: &BrdfModel,
+    optim: &ModuleOptimizer,
+    state: &CheckpointState,
+) -> Result<PathBuf> {
+    let root = run.join(CHECKPOINTS_DIR);
+    let dir = checkpoint_dir(run, state.step);
+    let tmp = root.join(format!(".tmp-step-{:09}-{}", state.step, std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    std::fs::create_dir_all(&tmp).map_err(|e| Error::io(&tmp, e))?;
+    model
+        .clone()
+        .save_file(tmp.join(MODEL))
+        .map_err(|e| Error::format(tmp.join(MODEL), format!("cannot write weights: {e:?}")))?;
+    optim
+        .save(tmp.join(OPTIM))
+        .map_err(|e| Error::format(tmp.join(OPTIM), format!("cannot write Adam state: {e:?}")))?;
+    let json = serde_json::to_string(state).map_err(|e| Error::format(&tmp, e.to_string()))?;
+    std::fs::write(tmp.join(STATE), json).map_err(|e| Error::io(tmp.join(STATE), e))?;
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::rename(&tmp, &dir).map_err(|e| Error::io(&dir, e))?;
+    for old in list(run)? {
+        if old.0 != state.step {
+            let _ = std::fs::remove_dir_all(&old.1);
+        }
+    }
+    Ok(dir)
+}
+
+/// Complete checkpoints of a run, oldest first.
+pub fn list(run: &Path) -> Result<Vec<(u64, PathBuf)>> {
+    let root = run.join(CHECKPOINTS_DIR);
+    let entries = match std::fs::read_dir(&root) {
+        Ok(e) => e,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(Error::io(&root, e)),
+    };
+    let mut out = Vec::new();
+    for entry in entries {
+        let entry = entry.map_err(|e| Error::io(&root, e))?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if let Some(step) = name.strip_prefix("step-").and_then(|s| s.parse::<u64>().ok())
+            && entry.path().join(STATE).is_file()
+        {
+            out.push((step, entry.path()));
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// The latest checkpoint, if any.
+pub fn latest(run: &Path) -> Result<Option<PathBuf>> {
+    Ok(list(run)?.pop().map(|(_, p)| p))
+}
+
+/// Loads a checkpoint into a freshly initialised model and optimizer of the same
+/// configuration.
+pub fn load(
+    dir: &Path,
+    model: BrdfModel,
+    optim: ModuleOptimizer,
+) -> Result<(BrdfModel, ModuleOptimizer, CheckpointState)> {
+    let model = model
+        .try_load_file(dir.join(MODEL))
+        .map_err(|e| Error::format(dir.join(MODEL), format!("cannot load weights: {e:?}")))?;
+    let optim = optim
+        .load(dir.join(OPTIM))
+        .map_err(|e| Error::format(dir.join(OPTIM), format!("cannot load Adam state: {e:?}")))?;
+    let path = dir.join(STATE);
+    let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+    let state = serde_json::from_str(&text).map_err(|e| Error::format(&path, e.to_string()))?;
+    Ok((model, optim, state))
+}

@@ -1,0 +1,76 @@
+//! Which parameter group of a model holds non-finite (or the largest) values: the message a
+//! non-finite loss stops the run with.
+
+use brdf_neural::BrdfModel;
+use burn::module::{Module, ModuleVisitor, Param};
+use burn::tensor::Tensor;
+
+/// Summary of one parameter tensor.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParamHealth {
+    /// Module path, e.g. `SingleMlp.mlp.layers.0.weight`.
+    pub path: String,
+    /// Number of NaN or infinite entries.
+    pub non_finite: usize,
+    /// Largest finite magnitude.
+    pub max_abs: f32,
+}
+
+#[derive(Default)]
+struct Visitor {
+    stack: Vec<String>,
+    out: Vec<ParamHealth>,
+}
+
+impl ModuleVisitor for Visitor {
+    fn enter_module(&mut self, name: &str, _container_type: &str) {
+        self.stack.push(name.to_string());
+    }
+
+    fn exit_module(&mut self, _name: &str, _container_type: &str) {
+        self.stack.pop();
+    }
+
+    fn visit_float<const D: usize>(&mut self, param: &Param<Tensor<D>>) {
+        let values: Vec<f32> =
+            param.val().into_data().convert::<f32>().try_to_vec::<f32>().unwrap_or_default();
+        let non_finite = values.iter().filter(|v| !v.is_finite()).count();
+        let max_abs = values.iter().filter(|v| v.is_finite()).fold(0.0_f32, |m, v| m.max(v.abs()));
+        let path = if self.stack.is_empty() { "<root>".into() } else { self.stack.join(".") };
+        self.out.push(ParamHealth { path, non_finite, max_abs });
+    }
+}
+
+/// Health of every float parameter of `model`, in visiting order.
+pub fn param_health(model: &BrdfModel) -> Vec<ParamHealth> {
+    let mut v = Visitor::default();
+    model.visit(&mut v);
+    v.out
+}
+
+/// A sentence naming the parameter groups with non-finite values, or, when all are finite,
+/// the group with the largest magnitude (the forward pass overflowed or the inputs were bad).
+pub fn diagnose(model: &BrdfModel) -> String {
+    let health = param_health(model);
+    let bad: Vec<String> = health
+        .iter()
+        .filter(|h| h.non_finite > 0)
+        .map(|h| format!("{} ({} non-finite)", h.path, h.non_finite))
+        .collect();
+    if !bad.is_empty() {
+        return format!("non-finite parameters in {}", bad.join(", "));
+    }
+    match health.iter().max_by(|a, b| a.max_abs.total_cmp(&b.max_abs)) {
+        Some(h) => format!(
+            "all parameters finite; largest magnitude {:e} in {} (the forward pass overflowed: \
+             lower train.learning_rate)",
+            h.max_abs, h.path
+        ),
+        None => "the model has no parameter".into(),
+    }
+}
+
+/// Whether every parameter of `model` is finite.
+pub fn all_finite(model: &BrdfModel) -> bool {
+    param_health(model).iter().all(|h| h.non_finite == 0)
+}

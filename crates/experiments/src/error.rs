@@ -1,0 +1,94 @@
+//! The crate's error type: every variant names the file, the key or the step at fault.
+
+use std::path::PathBuf;
+
+/// Errors of training and evaluation.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A configuration file could not be parsed (unknown key, wrong type); serde's message
+    /// names the key.
+    #[error("{}: {message}", path.display())]
+    ConfigParse {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// A configuration value is out of range.
+    #[error("config key `{key}`: {message}")]
+    Config {
+        /// The dotted key, e.g. `train.learning_rate`.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// File system error.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file or directory.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// A file has unexpected content.
+    #[error("{}: {message}", path.display())]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The dataset could not be opened or read.
+    #[error("dataset: {0}")]
+    Dataset(#[from] dataset_merl::Error),
+    /// The LBO encoding failed.
+    #[error("LBO encoding: {0}")]
+    Encoding(#[from] mesh_encoding::Error),
+    /// The model could not be built or fed.
+    #[error("model: {0}")]
+    Model(#[from] brdf_neural::Error),
+    /// A metric failed.
+    #[error("metrics: {0}")]
+    Metrics(#[from] metrics::Error),
+    /// The loss became NaN or infinite; the last good checkpoint is kept.
+    #[error(
+        "non-finite loss ({loss}) at step {step}: {diagnosis}; the last good checkpoint is {}",
+        checkpoint.as_ref().map_or("none".into(), |p| p.display().to_string())
+    )]
+    NonFinite {
+        /// The step whose loss was not finite.
+        step: u64,
+        /// The loss value.
+        loss: f32,
+        /// Which parameter group is at fault.
+        diagnosis: String,
+        /// The last good checkpoint.
+        checkpoint: Option<PathBuf>,
+    },
+    /// The scene has no training sample.
+    #[error("{}: no lit training sample", path.display())]
+    NoSamples {
+        /// The scene.
+        path: PathBuf,
+    },
+}
+
+impl Error {
+    /// A range error for `key`.
+    pub fn config(key: &str, message: impl Into<String>) -> Self {
+        Error::Config { key: key.into(), message: message.into() }
+    }
+
+    /// An I/O error on `path`.
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io { path: path.into(), source }
+    }
+
+    /// A format error in `path`.
+    pub fn format(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
+        Error::Format { path: path.into(), message: message.into() }
+    }
+}
+
+/// Result with [`Error`].
+pub type Result<T> = std::result::Result<T, Error>;

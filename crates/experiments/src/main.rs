@@ -1,0 +1,100 @@
+//! The `experiments` command line: `fit` trains a model on a scene into a run directory, `eval`
+//! renders the test images of a finished run and computes its metrics.
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+use experiments::config::RunConfig;
+use experiments::run_dir::CONFIG_FILE;
+use experiments::{FitOptions, FitOutcome};
+use std::path::PathBuf;
+
+/// Neural BRDF experiments: training and evaluation.
+#[derive(Parser)]
+#[command(name = "experiments", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Train a model on a scene's training split into a run directory (resumes an existing run
+    /// from its last checkpoint; a finished run is reported and skipped).
+    Fit {
+        /// Run configuration (TOML). Optional when RUN already holds a config.toml.
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Scene directory (overrides `scene` in the config).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Run directory.
+        #[arg(long)]
+        out: PathBuf,
+        /// Eigenpair cache directory (default: `<out>/../cache`).
+        #[arg(long)]
+        cache: Option<PathBuf>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Render the test images of a finished run into `<run>/renders/` and add the test metrics
+    /// (PSNR, DSSIM, HDR-FLIP, cube-root RMSE) to `<run>/metrics.json`.
+    Eval {
+        /// Run directory.
+        run: PathBuf,
+        /// Scene directory (default: the one in the run's config).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Eigenpair cache directory (default: `<run>/../cache`).
+        #[arg(long)]
+        cache: Option<PathBuf>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+}
+
+fn main() -> Result<()> {
+    match Cli::parse().command {
+        Command::Fit { config, scene, out, cache, quiet } => {
+            let stored = out.join(CONFIG_FILE);
+            let path = match config {
+                Some(p) => p,
+                None if stored.is_file() => stored,
+                None => bail!("--config is required for a new run ({} has none)", out.display()),
+            };
+            let mut cfg = RunConfig::read(&path)?;
+            if let Some(scene) = scene {
+                cfg.scene = Some(std::path::absolute(&scene).unwrap_or(scene));
+            }
+            let options = FitOptions { progress: !quiet, cache_dir: cache, ..Default::default() };
+            match experiments::fit(&cfg, &out, options)
+                .with_context(|| format!("fit into {}", out.display()))?
+            {
+                FitOutcome::AlreadyFinished(m) => {
+                    println!("{}: already finished ({} steps), skipped", out.display(), m.steps)
+                }
+                FitOutcome::Finished { metrics: m, resumed_from } => {
+                    if resumed_from > 0 {
+                        println!("resumed from step {resumed_from}");
+                    }
+                    println!(
+                        "{}: {} steps in {:.1} s, {:.0} samples/s, final loss {:.4e}",
+                        out.display(),
+                        m.steps,
+                        m.wall_seconds,
+                        m.samples_per_second,
+                        m.final_train_loss
+                    );
+                }
+                FitOutcome::Stopped(step) => println!("stopped after step {step}"),
+            }
+        }
+        Command::Eval { run, scene, cache, quiet } => {
+            let metrics = experiments::eval::eval(&run, scene.as_deref(), cache.as_deref(), !quiet)
+                .with_context(|| format!("eval of {}", run.display()))?;
+            println!("{}", serde_json::to_string_pretty(&metrics)?);
+        }
+    }
+    Ok(())
+}

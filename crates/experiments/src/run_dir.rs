@@ -1,0 +1,99 @@
+//! The run directory and its files, all written atomically (temporary file in the same
+//! directory, then rename).
+//!
+//! ```text
+//! <run>/config.toml        the resolved configuration
+//! <run>/metrics.json       final train loss, samples/s, wall time, steps (eval adds test metrics)
+//! <run>/curve.csv          step,loss,lr,seconds
+//! <run>/weights.bpk        final model weights (burnpack)
+//! <run>/checkpoints/step-NNNNNNNNN/{model.bpk, optim.bpk, state.json}
+//! <run>/renders/           eval: per test image EXR + sRGB PNG
+//! ```
+
+use crate::{Error, Result};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The resolved configuration.
+pub const CONFIG_FILE: &str = "config.toml";
+/// Metrics of the run.
+pub const METRICS_FILE: &str = "metrics.json";
+/// Training curve.
+pub const CURVE_FILE: &str = "curve.csv";
+/// Final weights.
+pub const WEIGHTS_FILE: &str = "weights.bpk";
+/// Checkpoint folder.
+pub const CHECKPOINTS_DIR: &str = "checkpoints";
+
+/// Writes `bytes` to `path` atomically (temporary file beside it, then rename).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let tmp = temp_path(path);
+    std::fs::write(&tmp, bytes).map_err(|e| Error::io(&tmp, e))?;
+    std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
+}
+
+/// A temporary sibling of `path` (same directory, so a rename is atomic).
+pub fn temp_path(path: &Path) -> PathBuf {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    // Keeps the extension: burn's writers may append theirs to a name without it.
+    path.with_file_name(format!(".tmp-{}-{name}", std::process::id()))
+}
+
+/// One row of the training curve.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CurveRow {
+    /// Steps done (1-based: the loss of step `step - 1`).
+    pub step: u64,
+    /// Training loss of that step.
+    pub loss: f32,
+    /// Its learning rate.
+    pub lr: f64,
+    /// Training wall time so far, seconds.
+    pub seconds: f64,
+}
+
+/// Writes the curve as CSV.
+pub fn write_curve(path: &Path, rows: &[CurveRow]) -> Result<()> {
+    let mut s = String::from("step,loss,lr,seconds\n");
+    for r in rows {
+        s.push_str(&format!("{},{:e},{:e},{:.3}\n", r.step, r.loss, r.lr, r.seconds));
+    }
+    write_atomic(path, s.as_bytes())
+}
+
+/// `metrics.json`: training figures, and the test metrics once evaluated.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RunMetrics {
+    /// Steps done.
+    pub steps: u64,
+    /// Mean loss over the last curve rows (the last 10 % of the run, at least one row).
+    pub final_train_loss: f32,
+    /// Training samples per second (whole run, including resumed parts).
+    pub samples_per_second: f64,
+    /// Training wall time, seconds.
+    pub wall_seconds: f64,
+    /// Lit training records.
+    pub train_records: usize,
+    /// Model parameters.
+    pub parameters: usize,
+    /// Test metrics (`eval`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub test: Option<crate::eval::TestMetrics>,
+}
+
+impl RunMetrics {
+    /// Reads `metrics.json`.
+    pub fn read(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        serde_json::from_str(&text).map_err(|e| Error::format(path, e.to_string()))
+    }
+
+    /// Writes `metrics.json` atomically.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let text =
+            serde_json::to_string_pretty(self).map_err(|e| Error::format(path, e.to_string()))?;
+        write_atomic(path, text.as_bytes())
+    }
+}

@@ -1,0 +1,200 @@
+//! Training end to end on a tiny Lambertian sphere-over-plane scene (64 x 64, 4 views, 6
+//! lights) with `spatial = "position"`: the loss drops for Single MLP and Disney, runs are
+//! deterministic, a resumed run equals an uninterrupted one, a non-finite loss stops the run
+//! naming the step and the parameters and keeps the last checkpoint, and eval writes renders
+//! and finite metrics.
+
+use burn::module::{ModuleMapper, Param};
+use burn::tensor::Tensor;
+use dataset_merl::scene::{MaterialSpec, SceneConfig, SceneSettings};
+use experiments::run_dir::{CURVE_FILE, WEIGHTS_FILE};
+use experiments::{Error, FitOptions, FitOutcome, RunConfig, fit};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// A fresh directory under the system temp dir, removed on drop.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(tag: &str) -> Self {
+        let p = std::env::temp_dir().join(format!("experiments-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&p);
+        std::fs::create_dir_all(&p).unwrap();
+        Self(p)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// OBJ of a UV sphere (radius 0.5, centre (0, 0, 0.7)) above the square z = 0.
+fn sphere_over_plane(dir: &Path) -> PathBuf {
+    let mut obj = String::new();
+    let (rings, segs) = (16, 32);
+    for i in 0..=rings {
+        let th = std::f64::consts::PI * i as f64 / rings as f64;
+        for j in 0..segs {
+            let ph = std::f64::consts::TAU * j as f64 / segs as f64;
+            let (x, y, z) = (th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
+            let _ = writeln!(obj, "v {} {} {}", 0.5 * x, 0.5 * y, 0.7 + 0.5 * z);
+        }
+    }
+    let idx = |i: usize, j: usize| i * segs + (j % segs) + 1;
+    for i in 0..rings {
+        for j in 0..segs {
+            let (a, b, c, d) = (idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1));
+            if i != 0 {
+                let _ = writeln!(obj, "f {a} {b} {d}");
+            }
+            if i != rings - 1 {
+                let _ = writeln!(obj, "f {b} {c} {d}");
+            }
+        }
+    }
+    let base = (rings + 1) * segs;
+    for (x, y) in [(-1.5, -1.5), (1.5, -1.5), (1.5, 1.5), (-1.5, 1.5)] {
+        let _ = writeln!(obj, "v {x} {y} 0");
+    }
+    let (p, q, r, s) = (base + 1, base + 2, base + 3, base + 4);
+    let _ = writeln!(obj, "f {p} {q} {r}\nf {p} {r} {s}");
+    let path = dir.join("sphere_plane.obj");
+    std::fs::write(&path, obj).unwrap();
+    path
+}
+
+/// The scene, generated once per test process.
+fn scene() -> &'static Path {
+    static SCENE: OnceLock<(TempDir, PathBuf)> = OnceLock::new();
+    &SCENE
+        .get_or_init(|| {
+            let dir = TempDir::new("scene");
+            let config = SceneConfig {
+                mesh: sphere_over_plane(&dir.0),
+                material: MaterialSpec::Lambert { albedo: [0.6, 0.3, 0.15] },
+                seed: 3,
+                settings: SceneSettings {
+                    width: 64,
+                    height: 64,
+                    views: 4,
+                    train_views: 2,
+                    lights_per_view: 6,
+                    train_lights: 4,
+                    ..SceneSettings::default()
+                },
+                merl_dir: None,
+            };
+            let out = dir.0.join("scene");
+            dataset_merl::generate_scene(&config, &out, false).unwrap();
+            (dir, out)
+        })
+        .1
+}
+
+fn config(kind: &str, iterations: u64, extra: &str) -> RunConfig {
+    let text = format!(
+        "seed = 5\n[model]\nkind = \"{kind}\"\nwidth = 32\n[features]\nspatial = \"position\"\n\
+         [train]\niterations = {iterations}\nbatch_size = 2048\nlearning_rate = 5e-3\n\
+         lr_final = 1e-3\ncheckpoint_every = 20\nlog_every = 10\n{extra}"
+    );
+    let mut c = RunConfig::from_toml(&text, Path::new("test.toml")).unwrap();
+    c.scene = Some(scene().to_path_buf());
+    c
+}
+
+fn losses(run: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(run.join(CURVE_FILE)).unwrap();
+    text.lines().skip(1).map(|l| l.split(',').take(2).collect::<Vec<_>>().join(",")).collect()
+}
+
+fn loss_values(run: &Path) -> Vec<f32> {
+    losses(run).iter().map(|l| l.split(',').nth(1).unwrap().parse().unwrap()).collect()
+}
+
+#[test]
+fn single_mlp_and_disney_fit_the_scene_and_eval_scores_them() {
+    let dir = TempDir::new("fit");
+    for kind in ["single_mlp", "disney"] {
+        let run = dir.0.join(kind);
+        let out = fit(&config(kind, 300, ""), &run, FitOptions::default()).unwrap();
+        let FitOutcome::Finished { metrics, resumed_from: 0 } = out else { panic!("{out:?}") };
+        assert_eq!(metrics.steps, 300);
+        let l = loss_values(&run);
+        let first = l[0];
+        let last = l[l.len() - 3..].iter().sum::<f32>() / 3.0;
+        // A Lambertian scene is easy: both models must lose at least 80 % of the first loss.
+        assert!(last < 0.2 * first, "{kind}: loss {first} -> {last}");
+        assert!(run.join(WEIGHTS_FILE).is_file());
+        // A finished run is reported and skipped.
+        let again = fit(&config(kind, 300, ""), &run, FitOptions::default()).unwrap();
+        assert!(matches!(again, FitOutcome::AlreadyFinished(_)), "{again:?}");
+        let test = experiments::eval::eval(&run, None, None, false).unwrap();
+        assert!(test.images == 4 && test.psnr.is_finite() && test.psnr > 15.0, "{kind}: {test:?}");
+        assert!(test.flip.is_finite() && test.dssim.is_finite() && test.rmse_cbrt.is_finite());
+        assert!(run.join("renders/view000_light004.png").is_file() || test.images > 0);
+    }
+}
+
+#[test]
+fn runs_are_deterministic_and_resume_is_exact() {
+    let dir = TempDir::new("resume");
+    let c = config("single_mlp", 60, "");
+    let (a, b, r) = (dir.0.join("a"), dir.0.join("b"), dir.0.join("r"));
+    fit(&c, &a, FitOptions::default()).unwrap();
+    fit(&c, &b, FitOptions::default()).unwrap();
+    assert_eq!(losses(&a), losses(&b));
+    let stop = FitOptions { stop_after: Some(30), ..Default::default() };
+    assert_eq!(fit(&c, &r, stop).unwrap(), FitOutcome::Stopped(30));
+    let out = fit(&c, &r, FitOptions::default()).unwrap();
+    assert!(matches!(out, FitOutcome::Finished { resumed_from: 30, .. }), "{out:?}");
+    assert_eq!(losses(&a), losses(&r));
+    // A different configuration in the same run directory is refused.
+    let other = config("single_mlp", 61, "");
+    assert!(fit(&other, &r, FitOptions::default()).unwrap_err().to_string().contains("config"));
+}
+
+struct Poison;
+
+impl ModuleMapper for Poison {
+    fn map_float<const D: usize>(&mut self, param: Param<Tensor<D>>) -> Param<Tensor<D>> {
+        param.map(|t| t.add_scalar(f32::NAN))
+    }
+}
+
+#[test]
+fn a_non_finite_loss_stops_the_run_and_keeps_the_last_checkpoint() {
+    let dir = TempDir::new("nan");
+    let run = dir.0.join("run");
+    let hook =
+        Box::new(
+            |step: u64, model: brdf_neural::BrdfModel| {
+                if step == 25 { burn::module::Module::map(model, &mut Poison) } else { model }
+            },
+        );
+    let options = FitOptions { hook: Some(hook), ..Default::default() };
+    let err = fit(&config("disney", 100, ""), &run, options).unwrap_err();
+    let msg = err.to_string();
+    assert!(matches!(err, Error::NonFinite { step: 25, .. }), "{msg}");
+    assert!(msg.contains("step 25") && msg.contains("non-finite parameters in"), "{msg}");
+    assert!(msg.contains("step-000000020"), "{msg}");
+    assert!(run.join("checkpoints/step-000000020/model.bpk").is_file());
+    assert!(!run.join(WEIGHTS_FILE).exists());
+}
+
+#[test]
+fn an_absurd_learning_rate_is_caught() {
+    let dir = TempDir::new("lr");
+    let run = dir.0.join("run");
+    let c = config("single_mlp", 200, "schedule = \"constant\"\n");
+    let mut c = c;
+    c.train.learning_rate = 1e30;
+    match fit(&c, &run, FitOptions::default()) {
+        Err(Error::NonFinite { step, diagnosis, .. }) => {
+            assert!(step < 200 && !diagnosis.is_empty());
+        }
+        other => panic!("expected a non-finite loss, got {other:?}"),
+    }
+}
