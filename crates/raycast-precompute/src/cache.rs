@@ -98,11 +98,11 @@ pub fn cache_path(dir: &Path, key: u128) -> PathBuf {
     dir.join(format!("raycast-{key:032x}.bin"))
 }
 
-/// The precompute of [`crate::precompute`], loaded from `cache_dir` when a valid file for the same
+/// The precompute of [`crate::precompute()`], loaded from `cache_dir` when a valid file for the same
 /// content exists, else computed and stored there (the directory is created if needed).
 ///
 /// # Errors
-/// [`Error::View`] for invalid views (as [`crate::precompute`]) and [`Error::Io`] when the cache
+/// [`Error::View`] for invalid views (as [`crate::precompute()`]) and [`Error::Io`] when the cache
 /// directory or file cannot be created or written. A corrupted file is not an error.
 pub fn precompute_cached(
     mesh: &TriMesh,

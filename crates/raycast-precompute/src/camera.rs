@@ -41,7 +41,7 @@ impl Camera {
     ///
     /// # Errors
     /// [`Error::Camera`] when a value is not finite, K is not upper triangular with positive
-    /// focal lengths and K[2][2] = 1, R is not a rotation (orthonormal, det 1, tolerance 1e-3)
+    /// focal lengths and `K[2][2] = 1`, R is not a rotation (orthonormal, det 1, tolerance 1e-3)
     /// or the image is empty.
     pub fn from_opencv(k: Mat3, r: Mat3, t: Vec3, width: u32, height: u32) -> Result<Self> {
         let bad = |m: &str| Err(Error::Camera(m.to_string()));

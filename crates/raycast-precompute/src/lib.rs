@@ -13,7 +13,7 @@
 //! * [`packet`]: any-hit traversal of up to 64 shadow rays sharing one direction at once.
 //! * `packet_closest`: closest-hit traversal of up to 64 camera rays at once (AVX-512, x86-64).
 //! * [`brute_force`]: the f64 all-triangles reference the tracer is tested against.
-//! * [`precompute`]: primary and shadow rays for a scene, skipping background pixels and
+//! * [`precompute`](mod@precompute): primary and shadow rays for a scene, skipping background pixels and
 //!   back-facing lights.
 //! * [`shadows`]: the shadow-ray stage, in 8 x 8-tile packets per light or one ray at a time.
 //! * [`visibility`]: the (pixel, light) bitsets.

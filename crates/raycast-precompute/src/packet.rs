@@ -12,7 +12,7 @@
 //! scaled inverse direction, rounded, plus the ray's scaled origin offset, rounded; max/min with
 //! the same operands; `t_min` clamped to obvhs's node epsilon), a ray reaches exactly the leaves
 //! it would reach alone, and its triangles are tested with the same arithmetic as
-//! `RtTriangle::intersect` (see [`crate::packet_kernels`]). An any-hit query with a fixed `t_max`
+//! `RtTriangle::intersect` (see the crate-private `packet_kernels` module). An any-hit query with a fixed `t_max`
 //! does not depend on the traversal order, so the packet's order (front to back for the shared
 //! direction) changes only the speed.
 

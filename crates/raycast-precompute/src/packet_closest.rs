@@ -8,7 +8,7 @@
 //! descending priority (`slot ^ (7 - octant)`). The packet visits nodes in exactly this order
 //! (rays share the octant, so the priority order), and a ray takes part in a node only where its
 //! own box test passed, so every ray sees its own single-ray sequence of box and triangle tests,
-//! done with the same f32 operations (see [`crate::packet_kernels`]).
+//! done with the same f32 operations (see the crate-private `packet_kernels` module).
 
 #![cfg(target_arch = "x86_64")]
 
