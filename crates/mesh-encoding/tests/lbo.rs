@@ -6,7 +6,7 @@ mod common;
 
 use mesh_encoding::lbo::{
     CacheOutcome, EigenSettings, Eigenpairs, LboEncoding, LboEncodingConfig, LboMatrices,
-    cached_eigenpairs, dense_eigenpairs, smallest_eigenpairs,
+    cached_eigenpairs, dense_eigenpairs, eigenvalue_count_below, smallest_eigenpairs,
 };
 use mesh_encoding::{LoadOptions, load_mesh};
 
@@ -169,6 +169,39 @@ fn spectrum_slicing_agrees_with_dense_and_finds_every_pair() {
     assert!(pairs.orthonormality_error(&m.mass) < 1e-8);
     let res = pairs.relative_residuals(&m);
     assert!(res.iter().all(|r| *r < 1e-6), "residuals {res:?}");
+}
+
+#[test]
+fn inertia_counts_match_the_sphere_bands_and_the_solver_checks_them() {
+    let (v, f) = icosphere(3);
+    let m = LboMatrices::assemble(&v, &f).unwrap();
+    // Bands l = 0..3 near l(l+1) = 0, 2, 6, 12 with multiplicities 1, 3, 5, 7.
+    assert_eq!(eigenvalue_count_below(&m, -0.5).unwrap(), 0);
+    assert_eq!(eigenvalue_count_below(&m, 1.0).unwrap(), 1);
+    assert_eq!(eigenvalue_count_below(&m, 4.0).unwrap(), 4);
+    assert_eq!(eigenvalue_count_below(&m, 9.0).unwrap(), 9);
+    assert_eq!(eigenvalue_count_below(&m, 16.0).unwrap(), 16);
+    // The solver's own check: k = 20 ends inside the l = 4 band (16..25).
+    let (pairs, report) = smallest_eigenpairs(&m, 20, &small_settings()).unwrap();
+    let (mu, count) = report.inertia.expect("the sparse solver checks completeness");
+    assert_eq!(count, pairs.values.iter().filter(|&&x| x < mu).count());
+    assert!((12.0..20.0).contains(&mu), "check shift {mu} should sit between bands");
+}
+
+#[test]
+fn narrow_blocks_still_find_every_member_of_the_sphere_bands() {
+    // Blocks of 4 are narrower than the bands (multiplicity up to 9); a missed member would be
+    // caught by the inertia check and the solve retried with wider blocks.
+    let (v, f) = icosphere(3);
+    let m = LboMatrices::assemble(&v, &f).unwrap();
+    let k = 30;
+    let settings = EigenSettings { block_size: 4, ..Default::default() };
+    let (pairs, report) = smallest_eigenpairs(&m, k, &settings).unwrap();
+    assert!(!report.dense);
+    let dense = dense_eigenpairs(&m, k).unwrap();
+    for (i, (a, b)) in pairs.values.iter().zip(&dense.values).enumerate() {
+        assert!((a - b).abs() <= 1e-9 * b.abs().max(1.0), "pair {i}: {a} vs {b}");
+    }
 }
 
 #[test]

@@ -40,18 +40,18 @@
 use std::time::Instant;
 
 use faer::linalg::matmul::matmul;
-use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
 
 use super::assembly::LboMatrices;
+use super::lanczos::{Ritz, block_lanczos};
 use crate::error::{Error, Result};
 
 /// Settings of [`smallest_eigenpairs`]. They are part of the eigenpair cache key.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EigenSettings {
-    /// Largest number of vectors per Lanczos block (default 32; the solver uses at most `k / 8`,
+    /// Largest number of vectors per Lanczos block (default 16; the solver uses at most `k / 8`,
     /// at least 8). Larger blocks make the solves and GEMMs more efficient but need a larger
     /// basis.
     pub block_size: usize,
@@ -70,17 +70,34 @@ pub struct EigenSettings {
     /// eigenvalue counts by inertia); used when `k > 2 * slice_size`. Default 0: off, one shift
     /// (faster in the measurements so far).
     pub slice_size: usize,
+    /// Threads for faer's dense kernels inside the solver: 1 (default) sequential, 0 faer's
+    /// global setting, `t > 1` a rayon pool of `t`. Not part of the cache key (results differ
+    /// only by rounding). Sequential is the default because faer's rayon kernels were 3x slower
+    /// than sequential ones on a 2-core machine shared with other jobs (see `PERFORMANCE.md`).
+    pub threads: usize,
+}
+
+impl EigenSettings {
+    /// The faer parallelism of [`EigenSettings::threads`].
+    pub fn parallelism(&self) -> Par {
+        match self.threads {
+            0 => faer::get_global_parallelism(),
+            1 => Par::Seq,
+            t => Par::rayon(t),
+        }
+    }
 }
 
 impl Default for EigenSettings {
     fn default() -> Self {
         EigenSettings {
-            block_size: 32,
+            block_size: 16,
             tolerance: 1e-9,
             max_basis_factor: 6.0,
             shift_factor: -0.01,
             seed: 0x5eed,
             slice_size: 0,
+            threads: 1,
         }
     }
 }
@@ -162,7 +179,7 @@ impl Eigenpairs {
 }
 
 /// How a solve went.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct SolveReport {
     /// True when the dense reference solver was used (small problems).
     pub dense: bool,
@@ -174,6 +191,17 @@ pub struct SolveReport {
     pub ritz_checks: usize,
     /// Seconds spent in the symbolic and numeric factorisation.
     pub factor_seconds: f64,
+    /// Seconds in the block triangular solves (Lanczos operator applications).
+    pub solve_seconds: f64,
+    /// Seconds in the orthogonalisation of the Lanczos blocks.
+    pub orthogonalize_seconds: f64,
+    /// Seconds in the Rayleigh-Ritz checks (dense eigen of the projected matrix).
+    pub ritz_seconds: f64,
+    /// Seconds in the completeness check (one sparse `LDL^T` factorisation).
+    pub check_seconds: f64,
+    /// The completeness check: a shift `mu` and the exact number of eigenvalues below it, which
+    /// equals the number of returned values below `mu` (`None` when not checked).
+    pub inertia: Option<(f64, usize)>,
     /// Seconds of the whole solve.
     pub total_seconds: f64,
 }
@@ -215,11 +243,8 @@ pub fn smallest_eigenpairs(
         let pairs = dense_eigenpairs(matrices, k)?;
         let report = SolveReport {
             dense: true,
-            shift: 0.0,
-            basis_size: 0,
-            ritz_checks: 0,
-            factor_seconds: 0.0,
             total_seconds: start.elapsed().as_secs_f64(),
+            ..Default::default()
         };
         return Ok((pairs, report));
     }
@@ -228,7 +253,7 @@ pub fn smallest_eigenpairs(
     }
 
     // 1. Factor A = L - sigma M.
-    let par = faer::get_global_parallelism();
+    let par = settings.parallelism();
     let factor_start = Instant::now();
     let a = shifted_stiffness(matrices, shift)?;
     let symbolic = SymbolicLlt::try_new(a.symbolic(), Side::Lower)
@@ -240,83 +265,82 @@ pub fn smallest_eigenpairs(
     let sqrt_m: Vec<f64> = matrices.mass.iter().map(|m| m.sqrt()).collect();
     let d: Vec<f64> = sqrt_m.iter().map(|s| 1.0 / s).collect();
 
-    // 2. Block Lanczos with full reorthogonalisation.
-    let mut v = Mat::<f64>::zeros(n, max_basis + b);
-    let mut h = Mat::<f64>::zeros(max_basis + b, max_basis + b);
-    let mut rng = SplitMix64(settings.seed);
-    let mut w = Mat::<f64>::from_fn(n, b, |_, _| rng.uniform());
-    let r0 = orthonormalize_block(v.as_ref().subcols(0, 0), w.as_mut(), &mut rng, par);
-    drop(r0);
-    v.as_mut().subcols_mut(0, b).copy_from(&w);
-
-    let first_check = k + 2 * b;
-    let mut next_check = first_check;
-    let mut ritz_checks = 0;
-    let mut m = b; // basis size after the current block
+    // 2. Block Lanczos; a failed completeness check (an eigenvalue missed, possible for
+    //    clusters wider than the block) retries with a doubled block and another start.
+    let mut b = b;
+    let mut seed = settings.seed;
     loop {
-        let cur = m - b;
-        // W = Op V_j = M^(1/2) A^-1 M^(1/2) V_j
-        for j in 0..b {
-            let src = v.col_as_slice(cur + j);
-            for ((dst, s), si) in w.col_as_slice_mut(j).iter_mut().zip(src).zip(&sqrt_m) {
-                *dst = s * si;
-            }
-        }
-        llt.solve_in_place(w.as_mut());
-        for j in 0..b {
-            for (x, si) in w.col_as_slice_mut(j).iter_mut().zip(&sqrt_m) {
-                *x *= si;
-            }
-        }
-        // Two passes of block Gram-Schmidt against the whole basis, then QR of the rest.
-        let basis = v.as_ref().subcols(0, m);
-        for _ in 0..2 {
-            let coeff = basis.transpose() * &w;
-            matmul(w.as_mut(), Accum::Add, basis, &coeff, -1.0, par);
-            let mut hcol = h.as_mut().submatrix_mut(0, cur, m, b);
-            hcol += &coeff;
-        }
-        let r = orthonormalize_block(basis, w.as_mut(), &mut rng, par);
-        h.as_mut().submatrix_mut(m, cur, b, b).copy_from(&r);
-
-        if m >= next_check || m + b > max_basis {
-            ritz_checks += 1;
-            let ritz = rayleigh_ritz(h.as_ref(), m, b, k)?;
-            let converged = ritz
-                .values
-                .iter()
-                .zip(&ritz.residuals)
-                .all(|(theta, res)| *res <= settings.tolerance * theta.abs());
-            if converged {
-                let pairs = finish(matrices, v.as_ref().subcols(0, m), &ritz, &d, shift, par);
-                let report = SolveReport {
-                    dense: false,
-                    shift,
-                    basis_size: m,
-                    ritz_checks,
-                    factor_seconds,
-                    total_seconds: start.elapsed().as_secs_f64(),
-                };
-                return Ok((pairs, report));
-            }
-            if m + b > max_basis {
-                let worst = ritz
-                    .values
-                    .iter()
-                    .zip(&ritz.residuals)
-                    .map(|(t, r)| r / t.abs())
-                    .fold(0.0, f64::max);
+        let run = block_lanczos(&llt, &sqrt_m, k, b, max_basis, settings, seed, par)?;
+        let pairs = finish(matrices, run.basis.as_ref(), &run.ritz, k, &d, shift, par);
+        // 3. Completeness: Sylvester inertia of L - mu M just below the largest value.
+        let check_start = Instant::now();
+        let inertia = completeness_check(matrices, &pairs.values, par)?;
+        let check_seconds = check_start.elapsed().as_secs_f64();
+        let complete = inertia
+            .is_none_or(|(mu, count)| count == pairs.values.iter().filter(|&&x| x < mu).count());
+        if complete || 2 * b > max_basis / 8 {
+            if !complete {
                 return Err(Error::lbo(format!(
-                    "block Lanczos did not converge for {k} pairs within a basis of {m} \
-                     vectors (worst relative residual {worst:.2e}); raise max_basis_factor"
+                    "eigenvalue count check failed ({inertia:?}) even with blocks of {b}"
                 )));
             }
-            // Unconverged pairs sit at the end of the wanted range; grow by a tenth of k.
-            next_check = m + (k / 10).max(b).div_ceil(b) * b;
+            let report = SolveReport {
+                dense: false,
+                shift,
+                basis_size: run.basis.ncols(),
+                ritz_checks: run.checks,
+                factor_seconds,
+                solve_seconds: run.times.solve,
+                orthogonalize_seconds: run.times.orthogonalize,
+                ritz_seconds: run.times.ritz,
+                check_seconds,
+                inertia,
+                total_seconds: start.elapsed().as_secs_f64(),
+            };
+            return Ok((pairs, report));
         }
-        v.as_mut().subcols_mut(m, b).copy_from(&w);
-        m += b;
+        b *= 2;
+        seed = seed.wrapping_add(1);
     }
+}
+
+/// The exact number of eigenvalues of `L phi = lambda M phi` below `mu` (Sylvester's law of
+/// inertia: the negative pivots of a sparse `LDL^T` factorisation of `L - mu M`). Costs about
+/// one Cholesky factorisation.
+///
+/// # Errors
+/// [`Error::Lbo`] when the factorisation fails (for example `mu` numerically an eigenvalue).
+pub fn eigenvalue_count_below(matrices: &LboMatrices, mu: f64) -> Result<usize> {
+    super::slicing::count_below(matrices, mu, Par::Seq)
+}
+
+/// The inertia check of the solver: `(mu, number of eigenvalues below mu)` for `mu` in the
+/// gap (relative width at least `1e-4`) nearest below the largest of the sorted `values`, or
+/// in the widest gap among the last 32 when none is that wide; `None` for fewer than two
+/// values. The count is exact (Sylvester's law of inertia on an `LDL^T` factorisation).
+///
+/// # Errors
+/// [`Error::Lbo`] when the factorisation fails.
+pub(crate) fn completeness_check(
+    matrices: &LboMatrices,
+    values: &[f64],
+    par: Par,
+) -> Result<Option<(f64, usize)>> {
+    let k = values.len();
+    if k < 2 {
+        return Ok(None);
+    }
+    let rel_gap =
+        |i: usize| (values[i + 1] - values[i]) / values[i + 1].abs().max(f64::MIN_POSITIVE);
+    let lowest = k.saturating_sub(33);
+    let gap = (lowest..k - 1)
+        .rev()
+        .find(|&i| rel_gap(i) >= 1e-4)
+        .or_else(|| (lowest..k - 1).max_by(|&i, &j| rel_gap(i).total_cmp(&rel_gap(j))))
+        .expect("at least one gap");
+    let mu = 0.5 * (values[gap] + values[gap + 1]);
+    let count = super::slicing::count_below(matrices, mu, par)?;
+    Ok(Some((mu, count)))
 }
 
 /// `L - sigma M` as a sparse matrix (both triangles).
@@ -376,46 +400,20 @@ pub(crate) fn orthonormalize_block(
     r
 }
 
-/// Ritz values (the `k` largest `theta`, descending), their coefficient vectors in the basis and
-/// their Lanczos residual norms.
-struct Ritz {
-    values: Vec<f64>,
-    vectors: Mat<f64>,
-    residuals: Vec<f64>,
-}
-
-/// Rayleigh-Ritz on the projected matrix `H[0..m, 0..m]` (symmetrised).
-fn rayleigh_ritz(h: MatRef<'_, f64>, m: usize, b: usize, k: usize) -> Result<Ritz> {
-    let t = Mat::<f64>::from_fn(m, m, |i, j| 0.5 * (h[(i, j)] + h[(j, i)]));
-    let eig = t
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::lbo(format!("dense eigen of the projected matrix failed: {e:?}")))?;
-    let s = eig.S().column_vector();
-    let u = eig.U();
-    // Ascending order: the k largest are the last k; take them largest first.
-    let cols: Vec<usize> = (m - k..m).rev().collect();
-    let values: Vec<f64> = cols.iter().map(|&c| s[c]).collect();
-    let vectors = Mat::<f64>::from_fn(m, k, |i, j| u[(i, cols[j])]);
-    let coupling = h.submatrix(m, m - b, b, b);
-    let last = vectors.as_ref().subrows(m - b, b);
-    let res = coupling * last;
-    let residuals = (0..k).map(|j| res.col(j).norm_l2()).collect();
-    Ok(Ritz { values, vectors, residuals })
-}
-
 /// Ritz vectors, back-transformation and Rayleigh-quotient eigenvalues, sorted ascending.
 fn finish(
     matrices: &LboMatrices,
     basis: MatRef<'_, f64>,
     ritz: &Ritz,
+    k: usize,
     d: &[f64],
     shift: f64,
     par: Par,
 ) -> Eigenpairs {
     let n = basis.nrows();
-    let k = ritz.values.len();
     let mut phi = Mat::<f64>::zeros(n, k);
-    matmul(phi.as_mut(), Accum::Replace, basis, &ritz.vectors, 1.0, par);
+    let coeff = ritz.vectors.as_ref().subcols(0, k);
+    matmul(phi.as_mut(), Accum::Replace, basis, coeff, 1.0, par);
     for j in 0..k {
         for (x, di) in phi.col_as_slice_mut(j).iter_mut().zip(d) {
             *x *= di;

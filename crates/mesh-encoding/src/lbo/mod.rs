@@ -22,9 +22,13 @@ pub mod assembly;
 pub mod cache;
 pub mod eigen;
 pub mod encoding;
+mod lanczos;
 mod slicing;
 
 pub use assembly::LboMatrices;
 pub use cache::{CacheOutcome, cache_key, cached_eigenpairs};
-pub use eigen::{EigenSettings, Eigenpairs, SolveReport, dense_eigenpairs, smallest_eigenpairs};
+pub use eigen::{
+    EigenSettings, Eigenpairs, SolveReport, dense_eigenpairs, eigenvalue_count_below,
+    smallest_eigenpairs,
+};
 pub use encoding::{LboEncoding, LboEncodingConfig, block_selection};

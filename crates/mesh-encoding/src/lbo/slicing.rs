@@ -36,13 +36,11 @@ use faer::sparse::SparseColMat;
 use faer::sparse::linalg::cholesky::{
     SymbolicCholesky, SymbolicCholeskyRaw, factorize_symbolic_cholesky, simplicial, supernodal,
 };
-use faer::{Accum, Conj, Mat, Par, Side};
+use faer::{Accum, Conj, Mat, MatMut, Par, Side};
 
 use super::assembly::LboMatrices;
-use super::eigen::{
-    EigenSettings, Eigenpairs, SolveReport, SplitMix64, orthonormalize_block, sort_pairs,
-    weyl_spacing,
-};
+use super::eigen::{EigenSettings, Eigenpairs, SolveReport, sort_pairs, weyl_spacing};
+use super::lanczos::{Lanczos, PhaseTimes, next_checkpoint, worst_ratio};
 use crate::error::{Error, Result};
 
 /// One numeric `LDL^T` factor of `L - mu M` with its inertia.
@@ -100,6 +98,33 @@ fn factor_ldlt(
     Ok(ShiftFactor { values, below })
 }
 
+/// The exact number of eigenvalues of `L phi = lambda M phi` below `mu`: the negative pivots of
+/// an `LDL^T` factorisation of `L - mu M` (Sylvester's law of inertia; `M` is positive).
+///
+/// # Errors
+/// [`Error::Lbo`] when the factorisation fails (`mu` numerically an eigenvalue).
+pub(crate) fn count_below(matrices: &LboMatrices, mu: f64, par: Par) -> Result<usize> {
+    let mut a = matrices.stiffness.clone();
+    {
+        let l = matrices.stiffness.as_ref();
+        let col_ptr = l.col_ptr();
+        let vals = a.val_mut();
+        for j in 0..matrices.vertex_count() {
+            let rows = l.row_idx_of_col_raw(j);
+            let p = rows.iter().position(|&i| i == j).ok_or_else(|| Error::lbo("no diagonal"))?;
+            vals[col_ptr[j] + p] -= mu * matrices.mass[j];
+        }
+    }
+    let symbolic = factorize_symbolic_cholesky(
+        a.symbolic(),
+        Side::Lower,
+        faer::sparse::linalg::cholesky::SymmetricOrdering::Amd,
+        Default::default(),
+    )
+    .map_err(|e| Error::lbo(format!("symbolic factorisation failed: {e:?}")))?;
+    Ok(factor_ldlt(&symbolic, &a, par)?.below)
+}
+
 /// The sliced solve (see the module documentation). Called by
 /// [`super::smallest_eigenpairs`] for large `k`.
 pub(crate) fn sliced_eigenpairs(
@@ -109,7 +134,7 @@ pub(crate) fn sliced_eigenpairs(
 ) -> Result<(Eigenpairs, SolveReport)> {
     let start = Instant::now();
     let n = matrices.vertex_count();
-    let par = faer::get_global_parallelism();
+    let par = settings.parallelism();
     let weyl = weyl_spacing(matrices);
     let sigma = settings.shift_factor * weyl;
     let q = settings.slice_size.max(8);
@@ -145,7 +170,7 @@ pub(crate) fn sliced_eigenpairs(
     };
 
     let sqrt_m: Vec<f64> = matrices.mass.iter().map(|m| m.sqrt()).collect();
-    let mut rng = SplitMix64(settings.seed);
+    let mut times = PhaseTimes::default();
     // Slightly irrational step so shifts do not land on the integer spectrum of a unit sphere.
     let mut step = q as f64 * weyl * 1.0137;
     let mut lower = (sigma, 0usize);
@@ -179,8 +204,9 @@ pub(crate) fn sliced_eigenpairs(
                 count,
                 b,
                 settings,
-                &mut rng,
+                settings.seed.wrapping_add(found.len() as u64),
                 par,
+                &mut times,
             )?;
             ritz_checks += checks;
             max_basis_used = max_basis_used.max(basis);
@@ -209,13 +235,18 @@ pub(crate) fn sliced_eigenpairs(
         basis_size: max_basis_used,
         ritz_checks,
         factor_seconds,
+        solve_seconds: times.solve,
+        orthogonalize_seconds: times.orthogonalize,
+        ritz_seconds: times.ritz,
         total_seconds: start.elapsed().as_secs_f64(),
+        ..Default::default()
     };
     Ok((pairs, report))
 }
 
 /// Block Lanczos for one shift `mu`: returns the `count` converged eigenvectors (as `phi`,
-/// M-normed) with eigenvalues in `[lo, hi)`, the basis size used and the number of Ritz checks.
+/// M-normed) with eigenvalues in `[lo, hi)`, the basis size used and the number of Ritz checks;
+/// adds its phase times to `times`.
 #[allow(clippy::too_many_arguments)]
 fn slice_lanczos(
     symbolic: &SymbolicCholesky<usize>,
@@ -226,88 +257,72 @@ fn slice_lanczos(
     count: usize,
     b: usize,
     settings: &EigenSettings,
-    rng: &mut SplitMix64,
+    seed: u64,
     par: Par,
+    times: &mut PhaseTimes,
 ) -> Result<(Mat<f64>, usize, usize)> {
     let n = sqrt_m.len();
     let ldlt = faer::sparse::linalg::cholesky::LdltRef::new(symbolic, &f.values);
-    let mut solve_mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(b, par));
+    let solve = |w: MatMut<'_, f64>| {
+        let mut mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(w.ncols(), par));
+        ldlt.solve_in_place_with_conj(Conj::No, w, par, MemStack::new(&mut mem));
+    };
     let max_basis = ((settings.max_basis_factor * (2 * count) as f64) as usize)
         .max(2 * count + 40 * b)
         .min(n / 2)
         / b
         * b;
-    let mut v = Mat::<f64>::zeros(n, max_basis + b);
-    let mut h = Mat::<f64>::zeros(max_basis + b, max_basis + b);
-    let mut w = Mat::<f64>::from_fn(n, b, |_, _| rng.uniform());
-    orthonormalize_block(v.as_ref().subcols(0, 0), w.as_mut(), rng, par);
-    v.as_mut().subcols_mut(0, b).copy_from(&w);
-    let mut m = b;
+    let mut lz = Lanczos::new(&solve, sqrt_m, b, max_basis, seed, par);
+    // The wanted pairs are those with the largest |theta| (eigenvalues nearest mu); the
+    // interval's ends need a basis of a few times `count`.
+    let mut next_check = (2 * count).max(count + 2 * b).min(max_basis);
+    let mut history = None;
     let mut checks = 0;
     loop {
-        let cur = m - b;
-        for j in 0..b {
-            let src = v.col_as_slice(cur + j);
-            for ((dst, s), si) in w.col_as_slice_mut(j).iter_mut().zip(src).zip(sqrt_m) {
-                *dst = s * si;
-            }
+        lz.step();
+        let m = lz.len() - b;
+        if m < next_check && lz.len() <= max_basis {
+            continue;
         }
-        ldlt.solve_in_place_with_conj(Conj::No, w.as_mut(), par, MemStack::new(&mut solve_mem));
-        for j in 0..b {
-            for (x, si) in w.col_as_slice_mut(j).iter_mut().zip(sqrt_m) {
-                *x *= si;
-            }
-        }
-        let basis = v.as_ref().subcols(0, m);
-        for _ in 0..2 {
-            let coeff = basis.transpose() * &w;
-            matmul(w.as_mut(), Accum::Add, basis, &coeff, -1.0, par);
-            let mut hcol = h.as_mut().submatrix_mut(0, cur, m, b);
-            hcol += &coeff;
-        }
-        let r = orthonormalize_block(basis, w.as_mut(), rng, par);
-        h.as_mut().submatrix_mut(m, cur, b, b).copy_from(&r);
-
-        if m >= count {
-            checks += 1;
-            let t = Mat::<f64>::from_fn(m, m, |i, j| 0.5 * (h[(i, j)] + h[(j, i)]));
-            let eig = t
-                .self_adjoint_eigen(Side::Lower)
-                .map_err(|e| Error::lbo(format!("dense eigen of the projected matrix: {e:?}")))?;
-            let s = eig.S().column_vector();
-            let u = eig.U();
-            let coupling = h.as_ref().submatrix(m, m - b, b, b);
-            let res = coupling * u.subrows(m - b, b);
-            // Converged Ritz pairs whose eigenvalue mu + 1/theta lies in [lo, hi).
-            let chosen: Vec<usize> = (0..m)
-                .filter(|&i| {
-                    let lambda = mu + 1.0 / s[i];
-                    (lo..hi).contains(&lambda)
-                        && res.col(i).norm_l2() <= settings.tolerance * s[i].abs()
-                })
-                .collect();
-            if chosen.len() >= count {
-                let y = Mat::<f64>::from_fn(m, chosen.len(), |i, j| u[(i, chosen[j])]);
-                let mut phi = Mat::<f64>::zeros(n, chosen.len());
-                matmul(phi.as_mut(), Accum::Replace, basis, &y, 1.0, par);
-                for j in 0..phi.ncols() {
-                    for (x, si) in phi.col_as_slice_mut(j).iter_mut().zip(sqrt_m) {
-                        *x /= si;
-                    }
+        checks += 1;
+        let ritz = lz.ritz(m, true)?;
+        // Converged Ritz pairs whose eigenvalue mu + 1/theta lies in [lo, hi).
+        let chosen: Vec<usize> = (0..m)
+            .filter(|&i| {
+                let theta = ritz.values[i];
+                (lo..hi).contains(&(mu + 1.0 / theta))
+                    && ritz.residuals[i] <= settings.tolerance * theta.abs()
+            })
+            .collect();
+        if chosen.len() >= count {
+            let y = Mat::<f64>::from_fn(m, chosen.len(), |i, j| ritz.vectors[(i, chosen[j])]);
+            let mut phi = Mat::<f64>::zeros(n, chosen.len());
+            matmul(phi.as_mut(), Accum::Replace, lz.basis(), &y, 1.0, par);
+            for j in 0..phi.ncols() {
+                for (x, si) in phi.col_as_slice_mut(j).iter_mut().zip(sqrt_m) {
+                    *x /= si;
                 }
-                return Ok((phi, m, checks));
             }
-            if m + b > max_basis {
-                return Err(Error::lbo(format!(
-                    "slice [{lo:.4e}, {hi:.4e}): only {} of {count} eigenpairs converged within \
-                     a basis of {m} vectors; raise max_basis_factor",
-                    chosen.len()
-                )));
-            }
+            add_times(times, &lz.times);
+            return Ok((phi, m, checks));
         }
-        v.as_mut().subcols_mut(m, b).copy_from(&w);
-        m += b;
+        if lz.len() > max_basis {
+            return Err(Error::lbo(format!(
+                "slice [{lo:.4e}, {hi:.4e}): only {} of {count} eigenpairs converged within \
+                 a basis of {m} vectors; raise max_basis_factor",
+                chosen.len()
+            )));
+        }
+        let worst = worst_ratio(&ritz, count, settings.tolerance);
+        next_check = next_checkpoint(m, worst, history, b, max_basis);
+        history = Some((m, worst));
     }
+}
+
+fn add_times(total: &mut PhaseTimes, run: &PhaseTimes) {
+    total.solve += run.solve;
+    total.orthogonalize += run.orthogonalize;
+    total.ritz += run.ritz;
 }
 
 /// M-orthonormalises the columns of `x` together (dropping numerically dependent directions)
