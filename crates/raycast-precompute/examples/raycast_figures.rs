@@ -38,7 +38,7 @@ fn main() {
         let views = orbit_views(4, 42, 512, 2.6, 45.0, 11);
         let settings = PrecomputeSettings::default();
         let _warm = precompute_with_tracer(&tracer, &views[..1], &settings).unwrap();
-        // A/B: the one-by-one reference (A) and the packets (B), alternated, best of 3 each.
+        // A/B: the one-by-one reference (A) and the packets (B), alternated, best of 5 each.
         let mut best = f64::INFINITY;
         let mut best_simple = f64::INFINITY;
         let mut stats = Default::default();
@@ -80,7 +80,7 @@ fn main() {
 
         println!(
             "{name}: one-by-one {:.2} M rays/s, packets {:.2} M rays/s: {:.2}x (same process, \
-             alternated, best of 3, results bit-identical)",
+             alternated, best of 5, results bit-identical)",
             rays / best_simple / 1e6,
             rays / best / 1e6,
             best_simple / best
