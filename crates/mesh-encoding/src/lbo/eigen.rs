@@ -1,5 +1,6 @@
 //! The generalized symmetric eigensolver for the `k` smallest pairs of `L phi = lambda M phi`:
-//! shift-invert **block Lanczos with full reorthogonalisation** on one sparse Cholesky factor.
+//! shift-invert **block Lanczos with full reorthogonalisation** on one sparse Cholesky factor,
+//! with an exact **inertia check** that no eigenvalue was missed.
 //!
 //! # Method
 //! `M` is diagonal (lumped), so with `D = M^(-1/2)` the problem is the standard symmetric one
@@ -8,31 +9,33 @@
 //!    `sigma < 0` is a small negative shift (default `-0.01 * 4 pi / area`, a hundredth of the
 //!    Weyl spacing of the eigenvalues) so `A` is positive definite even though `L` is singular
 //!    (one constant null vector per connected component);
-//! 2. runs block Lanczos on the operator `Op = M^(1/2) A^-1 M^(1/2) = (C - sigma)^-1`, whose largest
-//!    eigenvalues `theta = 1 / (lambda - sigma)` are the wanted smallest `lambda`. Each step
-//!    solves one block of `b` right-hand sides (default 32) at once, so the factor is streamed
-//!    through the cache once per block rather than once per vector, and orthogonalises the new
-//!    block twice (block classical Gram-Schmidt, GEMM) against the whole basis: no loss of
-//!    orthogonality, no spurious copies, no restarts;
-//! 3. does Rayleigh-Ritz on the projected block-tridiagonal matrix (faer's dense self-adjoint
-//!    eigen) from the moment the basis holds `k + 2b` vectors, then every few blocks, until the
+//! 2. runs block Lanczos ([`super::lanczos`]) on `Op = M^(1/2) A^-1 M^(1/2) = (C - sigma)^-1`,
+//!    whose largest eigenvalues `theta = 1 / (lambda - sigma)` are the wanted smallest `lambda`.
+//!    Each step solves one block of `b` right-hand sides (default 16) at once, projects out the
+//!    last two blocks (the three-term recurrence), then orthogonalises once against the whole
+//!    basis with two GEMMs (a second pass only when the DGKS test asks for it; it never did on
+//!    the meshes measured). Rayleigh-Ritz on the projected matrix runs at a few checkpoints
+//!    (the first at `2.5 k` vectors, later ones extrapolated from the residual decay) until the
 //!    Lanczos residual `|R_j y_last|` of each of the `k` wanted Ritz pairs is below
 //!    `tolerance * theta` (the eigenvalue error is then of order `tolerance^2`);
-//! 4. forms the Ritz vectors with one GEMM, maps them back (`phi = D x`, so `Phi^T M Phi = I`
-//!    to rounding) and replaces each eigenvalue by its Rayleigh quotient `phi^T L phi`.
+//! 3. forms the Ritz vectors with one GEMM, maps them back (`phi = D x`, so `Phi^T M Phi = I`
+//!    to rounding) and replaces each eigenvalue by its Rayleigh quotient `phi^T L phi`;
+//! 4. checks completeness: one sparse `LDL^T` of `L - mu M` with `mu` in a gap just below the
+//!    largest returned eigenvalue gives, by Sylvester's law of inertia, the exact number of
+//!    eigenvalues below `mu`; it must equal the number of returned values below `mu` (reported
+//!    in [`SolveReport::inertia`]). On a mismatch (a cluster wider than the block can lose a
+//!    member) the solve is retried with doubled blocks and another start block.
 //!
 //! # Why this method
-//! The cost of the plain shift-invert Lanczos recipe (ARPACK, or faer's Krylov-Schur on a
-//! user operator) is dominated by hundreds of single-vector triangular solves, each streaming a
-//! factor of tens of MB through memory, plus BLAS-2 orthogonalisation. Here the solves come in
-//! blocks (far fewer passes over the factor) and everything else is BLAS-3: the basis
-//! orthogonalisation (`4 n m^2` flops for a basis of `m` vectors), the Ritz vectors (`2 n m k`)
-//! and the dense projected eigenproblem (`O(m^3)`). Block Krylov needs a somewhat larger basis
-//! than single-vector Lanczos for the same accuracy (the polynomial degree is `m / b`), which
-//! the GEMM speed more than pays for; keeping the whole basis (no restart) costs `8 n m` bytes,
-//! about 0.4 GB for 35k vertices and 513 pairs. LOBPCG was the alternative: it needs a
-//! preconditioner of comparable cost and many more iterations for 513 clustered pairs.
-//! Measured timings are in the crate's `lbo_bench` example and the project notes.
+//! The plain shift-invert Lanczos recipe (ARPACK) is dominated by hundreds of single-vector
+//! triangular solves and BLAS-2 orthogonalisation. Here solves come in blocks and everything
+//! else is BLAS-3. With 513 pairs the cost is the orthogonalisation (`2 n m^2` flops for a final
+//! basis of `m` vectors, about `2.9 k` with blocks of 16): the solves are a sixth of the time and
+//! the factorisation under 1 %. Keeping the whole basis (no restart) costs `8 n m` bytes. Blocks
+//! of 16 gave the smallest time on the bunny (8: smaller basis but slower narrow GEMMs; 24-64:
+//! larger basis). Spectrum slicing ([`super::slicing`], `slice_size > 0`) is an alternative
+//! with a smaller orthogonalisation cost but more factorisations and a global Rayleigh-Ritz;
+//! it was not faster at 513 pairs. Figures and how they were measured: `PERFORMANCE.md`.
 //!
 //! Small problems (when a basis of `k + 3b` vectors would exceed half the vertices) go to the
 //! dense reference solver [`dense_eigenpairs`] instead.

@@ -80,9 +80,11 @@ impl<'a> Lanczos<'a> {
         let n = sqrt_m.len();
         let mut rng = SplitMix64(seed);
         let mut w = Mat::<f64>::from_fn(n, b, |_, _| rng.uniform());
-        let mut v = Mat::<f64>::zeros(n, max_basis + b);
-        orthonormalize_block(v.as_ref().subcols(0, 0), w.as_mut(), &mut rng, par);
-        v.as_mut().subcols_mut(0, b).copy_from(&w);
+        // Capacity for the largest basis, but only the columns in use are touched (resident).
+        let mut v = Mat::<f64>::new();
+        v.reserve(n, max_basis + b);
+        orthonormalize_block(v.as_ref(), w.as_mut(), &mut rng, par);
+        v.resize_with(n, b, |i, j| w[(i, j)]);
         let h = Mat::<f64>::zeros(max_basis + b, max_basis + b);
         Lanczos { solve, sqrt_m, b, v, h, w, m: b, rng, par, times: PhaseTimes::default() }
     }
@@ -130,7 +132,8 @@ impl<'a> Lanczos<'a> {
         let basis = self.v.as_ref().subcols(0, m);
         let r = orthonormalize_block(basis, self.w.as_mut(), &mut self.rng, par);
         self.h.as_mut().submatrix_mut(m, cur, b, b).copy_from(&r);
-        self.v.as_mut().subcols_mut(m, b).copy_from(&self.w);
+        let w = &self.w;
+        self.v.resize_with(w.nrows(), m + b, |i, j| w[(i, j - m)]);
         self.m += b;
         self.times.orthogonalize += t.elapsed().as_secs_f64();
     }

@@ -5,7 +5,9 @@
 //! Pipeline, one module a step:
 //! * [`assembly`]: cotangent stiffness `L` and mixed-Voronoi lumped mass `M` ([`LboMatrices`]).
 //! * [`eigen`]: the `k` smallest pairs of `L phi = lambda M phi` ([`smallest_eigenpairs`],
-//!   shift-invert block Lanczos on a sparse Cholesky factor; [`dense_eigenpairs`] as reference).
+//!   shift-invert block Lanczos on a sparse Cholesky factor (`lanczos`), an inertia count as
+//!   completeness check, spectrum slicing (`slicing`) as an option; [`dense_eigenpairs`] as
+//!   reference). Timings: the crate's `PERFORMANCE.md`.
 //! * [`encoding`]: index selection, range rescaling, barycentric interpolation ([`LboEncoding`]).
 //! * [`cache`]: eigenpairs on disk under a content key ([`cached_eigenpairs`]).
 //!
