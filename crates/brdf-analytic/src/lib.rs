@@ -38,6 +38,7 @@ mod lambert;
 pub mod microfacet;
 mod params;
 mod phong;
+pub mod quadrature;
 mod torrance_sparrow;
 
 pub use angles::{Real, Vec3};
@@ -46,6 +47,10 @@ pub use batch::eval_batch;
 pub use batch::par_eval_batch;
 pub use brdf::{Brdf, Rgb};
 pub use disney::{Disney, DisneyParams};
+/// The FMBRDF normalisation rule: Gauss-Legendre nodes and the tail truncation (see [`Fmbrdf`]).
+pub use fmbrdf::quadrature::{
+    NODES as FMBRDF_NORMALIZATION_NODES, TAIL as FMBRDF_NORMALIZATION_TAIL,
+};
 pub use fmbrdf::{Fmbrdf, FmbrdfParams};
 pub use lambert::{Lambert, LambertParams};
 pub use params::ParamError;

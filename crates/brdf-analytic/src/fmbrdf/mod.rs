@@ -2,7 +2,7 @@
 
 mod geometry;
 mod network;
-mod quadrature;
+pub(crate) mod quadrature;
 mod weights;
 
 use crate::brdf::{Brdf, Rgb};

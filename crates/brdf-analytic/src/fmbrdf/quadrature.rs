@@ -19,45 +19,16 @@
 //! 100,000-step rectangle rule, which differs from the exact integral by ~1.3e-10 absolute
 //! (O(h^2)): < 3.3e-7 relative for alpha >= 0.01, up to 4.6e-5 at alpha = 0.001.
 
+use crate::quadrature::gauss_legendre;
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::sync::OnceLock;
 
-/// Number of Gauss-Legendre nodes.
-pub(crate) const NODES: usize = 24;
+/// Number of Gauss-Legendre nodes of the normalisation rule (the tensor twin in brdf-neural
+/// uses the same).
+pub const NODES: usize = 24;
 
 /// Truncation: the integrand is integrated up to exp(-(theta/alpha)^beta) = e^-TAIL.
-pub(crate) const TAIL: f64 = 40.0;
-
-/// Gauss-Legendre nodes and weights on [-1, 1], `n` points, by Newton iteration on the Legendre
-/// recurrence (accurate to a few ulp for the small `n` used here).
-pub(crate) fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    let legendre = |x: f64| {
-        // (P_n(x), P_{n-1}(x))
-        let (mut p0, mut p1) = (1.0, x);
-        for k in 2..=n {
-            let kf = k as f64;
-            (p0, p1) = (p1, ((2.0 * kf - 1.0) * x * p1 - (kf - 1.0) * p0) / kf);
-        }
-        (p1, p0)
-    };
-    (0..n)
-        .map(|i| {
-            let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-            for _ in 0..100 {
-                let (p, q) = legendre(x);
-                let dp = n as f64 * (x * p - q) / (x * x - 1.0);
-                let dx = p / dp;
-                x -= dx;
-                if dx.abs() < 1e-16 {
-                    break;
-                }
-            }
-            let (p, q) = legendre(x);
-            let dp = n as f64 * (x * p - q) / (x * x - 1.0);
-            (x, 2.0 / ((1.0 - x * x) * dp * dp))
-        })
-        .collect()
-}
+pub const TAIL: f64 = 40.0;
 
 /// The model's nodes, computed once.
 fn nodes() -> &'static [(f64, f64)] {

@@ -8,13 +8,12 @@
 
 use super::geometry::DEN_EPS;
 use super::{FmbrdfNets, Geometry};
+use brdf_analytic::quadrature::gauss_legendre;
 use burn::tensor::{Device, Tensor, TensorData};
 use std::f64::consts::{FRAC_PI_2, PI};
 
-/// Gauss-Legendre nodes of the normalization (as in `brdf-analytic`).
-const NODES: usize = 24;
-/// Tail cut: the integrand is below e^-40 beyond theta_max.
-const TAIL: f64 = 40.0;
+/// The normalisation rule of the scalar FMBRDF: the same nodes and tail cut, so the two agree.
+use brdf_analytic::{FMBRDF_NORMALIZATION_NODES as NODES, FMBRDF_NORMALIZATION_TAIL as TAIL};
 
 /// FMBRDF parameters.
 #[derive(Clone, Debug)]
@@ -31,34 +30,6 @@ pub struct FmbrdfTensorParams {
     pub alpha: Tensor<2>,
     /// GGD shape beta in [0.5, 4], one per object, `[1, 1]`.
     pub beta: Tensor<2>,
-}
-
-/// Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_n, as in `brdf-analytic`).
-fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    let legendre = |x: f64| {
-        let (mut p0, mut p1) = (1.0, x);
-        for k in 2..=n {
-            let kf = k as f64;
-            (p0, p1) = (p1, ((2.0 * kf - 1.0) * x * p1 - (kf - 1.0) * p0) / kf);
-        }
-        (p1, p0)
-    };
-    (0..n)
-        .map(|i| {
-            let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-            for _ in 0..100 {
-                let (p, q) = legendre(x);
-                let dx = p / (n as f64 * (x * p - q) / (x * x - 1.0));
-                x -= dx;
-                if dx.abs() < 1e-16 {
-                    break;
-                }
-            }
-            let (p, q) = legendre(x);
-            let dp = n as f64 * (x * p - q) / (x * x - 1.0);
-            (x, 2.0 / ((1.0 - x * x) * dp * dp))
-        })
-        .collect()
 }
 
 /// The normalization c(alpha, beta) of the GGD microfacet distribution.
