@@ -11,7 +11,8 @@ use crate::loss::srgb_oetf;
 use crate::{Error, Result};
 use angles::Frame;
 use dataset_merl::{SampleSet, SceneDataset};
-use mesh_encoding::{EigenSettings, LboEncoding, cached_eigenpairs};
+use mesh_encoding::lbo::dense_eigenpairs;
+use mesh_encoding::{EigenSettings, LboEncoding, LboMatrices, cached_eigenpairs};
 use std::path::Path;
 
 /// Samples ready for batching, struct of arrays.
@@ -86,6 +87,13 @@ impl TrainingData {
         d
     }
 
+    /// The gamma-MSE of predicting f = 0 everywhere: mean of gamma(L_obs)^2.
+    pub fn zero_prediction_loss(&self) -> f32 {
+        let sum: f64 =
+            self.observed_gamma.iter().flatten().map(|&g| g as f64 * g as f64).sum::<f64>();
+        (sum / (3 * self.len().max(1)) as f64) as f32
+    }
+
     /// Gathers the records at `indices`.
     pub fn gather(&self, indices: &[usize]) -> CpuBatch {
         let k = self.spatial_dim;
@@ -122,8 +130,7 @@ pub fn spatial_features(
             Ok((samples.position.iter().flat_map(|p| p.iter().copied()).collect(), 3))
         }
         SpatialKind::Lbo => {
-            let encoding = lbo_encoding(scene, features, cache_dir)?;
-            let dim = encoding.dim();
+            let (table, dim) = lbo_table(scene, features, cache_dir)?;
             let mut out = vec![0.0; samples.len() * dim];
             let tris = &scene.mesh.triangles;
             for (i, row) in out.chunks_mut(dim).enumerate() {
@@ -132,14 +139,64 @@ pub fn spatial_features(
                 let tri = *tris.get(t).ok_or_else(|| {
                     Error::format(&scene.dir, format!("sample {i} names triangle {t}"))
                 })?;
-                encoding.interpolate_into(tri, [1.0 - b1 - b2, b1, b2], row);
+                let b = [1.0 - b1 - b2, b1, b2];
+                for (k, &v) in tri.iter().enumerate() {
+                    let src = &table[v as usize * dim..(v as usize + 1) * dim];
+                    for (o, s) in row.iter_mut().zip(src) {
+                        *o += b[k] * s;
+                    }
+                }
             }
             Ok((out, dim))
         }
     }
 }
 
-/// The LBO encoding of the scene's mesh with the configured selection.
+/// The per-vertex LBO feature table `[vertices, dim]` of the scene's mesh, from
+/// `<cache_dir>/lbo-table-<mesh and solver key>-<selection>.f32` or computed (then cached).
+pub fn lbo_table(
+    scene: &SceneDataset,
+    features: &FeatureConfig,
+    cache_dir: &Path,
+) -> Result<(Vec<f32>, usize)> {
+    let sel = &features.lbo;
+    let config = sel.encoding()?;
+    let vertices: Vec<[f64; 3]> =
+        scene.mesh.positions.iter().map(|p| [p.x as f64, p.y as f64, p.z as f64]).collect();
+    let key = mesh_encoding::lbo::cache_key(
+        &vertices,
+        &scene.mesh.triangles,
+        config.required_pairs(),
+        &eigen_settings(features),
+    );
+    let path = cache_dir.join(format!(
+        "lbo-table-{key:032x}-{}-{}-{}-{}.f32",
+        sel.first, sel.blocks, sel.block_len, sel.k_max
+    ));
+    let dim = sel.dim();
+    if let Ok(bytes) = std::fs::read(&path)
+        && bytes.len() == vertices.len() * dim * 4
+    {
+        let table = bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]));
+        return Ok((table.collect(), dim));
+    }
+    let encoding = lbo_encoding(scene, features, cache_dir)?;
+    let table = encoding.as_slice().to_vec();
+    let bytes: Vec<u8> = table.iter().flat_map(|v| v.to_le_bytes()).collect();
+    crate::run_dir::write_atomic(&path, &bytes)?;
+    Ok((table, encoding.dim()))
+}
+
+fn eigen_settings(features: &FeatureConfig) -> EigenSettings {
+    EigenSettings { max_basis_factor: features.lbo.max_basis_factor, ..EigenSettings::default() }
+}
+
+/// Largest mesh (vertices) solved densely when the iterative eigensolver fails.
+pub const DENSE_LIMIT: usize = 6000;
+
+/// The LBO encoding of the scene's mesh with the configured selection: eigenpairs from the
+/// cache (iterative solver), or, when that solver fails on a mesh of at most [`DENSE_LIMIT`]
+/// vertices, from the dense solver.
 pub fn lbo_encoding(
     scene: &SceneDataset,
     features: &FeatureConfig,
@@ -149,12 +206,17 @@ pub fn lbo_encoding(
     let vertices: Vec<[f64; 3]> =
         scene.mesh.positions.iter().map(|p| [p.x as f64, p.y as f64, p.z as f64]).collect();
     std::fs::create_dir_all(cache_dir).map_err(|e| Error::io(cache_dir, e))?;
-    let (pairs, _) = cached_eigenpairs(
-        &vertices,
-        &scene.mesh.triangles,
-        config.required_pairs(),
-        &EigenSettings::default(),
-        cache_dir,
-    )?;
+    let k = config.required_pairs();
+    let settings = eigen_settings(features);
+    let pairs = match cached_eigenpairs(&vertices, &scene.mesh.triangles, k, &settings, cache_dir) {
+        Ok((pairs, _)) => pairs,
+        // The iterative solver's basis is capped at half the vertex count, too small for
+        // k = 513 on meshes of a few thousand vertices: solve those densely (not cached).
+        Err(_) if vertices.len() <= DENSE_LIMIT && k <= vertices.len() => {
+            let matrices = LboMatrices::assemble(&vertices, &scene.mesh.triangles)?;
+            dense_eigenpairs(&matrices, k)?
+        }
+        Err(e) => return Err(e.into()),
+    };
     Ok(LboEncoding::new(&pairs, &config)?)
 }

@@ -39,16 +39,16 @@ pub enum Error {
         message: String,
     },
     /// The dataset could not be opened or read.
-    #[error("dataset: {0}")]
+    #[error(transparent)]
     Dataset(#[from] dataset_merl::Error),
     /// The LBO encoding failed.
-    #[error("LBO encoding: {0}")]
+    #[error(transparent)]
     Encoding(#[from] mesh_encoding::Error),
     /// The model could not be built or fed.
-    #[error("model: {0}")]
+    #[error(transparent)]
     Model(#[from] brdf_neural::Error),
     /// A metric failed.
-    #[error("metrics: {0}")]
+    #[error(transparent)]
     Metrics(#[from] metrics::Error),
     /// The loss became NaN or infinite; the last good checkpoint is kept.
     #[error(

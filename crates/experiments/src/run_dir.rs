@@ -76,6 +76,9 @@ pub struct RunMetrics {
     pub wall_seconds: f64,
     /// Lit training records.
     pub train_records: usize,
+    /// The gamma-MSE of predicting f = 0 on all training records: the baseline a fit must
+    /// beat (a collapsed model sits here).
+    pub zero_prediction_loss: f32,
     /// Model parameters.
     pub parameters: usize,
     /// Test metrics (`eval`).

@@ -240,6 +240,7 @@ pub fn fit(config: &RunConfig, run: &Path, mut options: FitOptions) -> Result<Fi
         samples_per_second: state.step as f64 * bs as f64 / state.seconds.max(1e-9),
         wall_seconds: state.seconds,
         train_records: n,
+        zero_prediction_loss: data.zero_prediction_loss(),
         parameters: config.model.param_count(),
         test: None,
     };
