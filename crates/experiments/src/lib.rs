@@ -7,7 +7,18 @@
 //! * [`checkpoint`], [`run_dir`]: what a run directory holds, written atomically.
 //! * [`eval`]: test renders and metrics of a finished run.
 //!
-//! The binary `experiments` wraps these as `fit` and `eval` (`experiments --help`).
+//! The binary `experiments` wraps these as `fit` and `eval` (`experiments --help`):
+//!
+//! ```text
+//! experiments fit --config run.toml --scene scenes/spot__blue-acrylic --out runs/spot-single
+//! experiments eval runs/spot-single
+//! ```
+//!
+//! `fit` on an existing run directory resumes from its last checkpoint (the configuration must
+//! be the same; `--config` may be left out), and reports a finished run without training.
+//! Runs are deterministic for a seed on a given machine and thread count: the tests check that
+//! two runs give bit-identical loss curves and that a run interrupted and resumed equals an
+//! uninterrupted one (Adam's moments are checkpointed).
 //!
 //! Learning rate, schedule and iteration counts are the project's decisions (the paper gives
 //! none); see [`config`] for the profiles' defaults.

@@ -200,3 +200,28 @@ fn an_absurd_learning_rate_is_caught() {
         other => panic!("expected a non-finite loss, got {other:?}"),
     }
 }
+
+#[test]
+fn lbo_features_are_interpolated_and_cached() {
+    let dir = TempDir::new("lbo");
+    let text = "[features]\nspatial = \"lbo\"\n[features.lbo]\nk_max = 24\nfirst = 8\nblocks = 2\n\
+                block_len = 4\n";
+    let mut c = RunConfig::from_toml(text, Path::new("lbo.toml")).unwrap();
+    c.scene = Some(scene().to_path_buf());
+    assert_eq!(c.model.spatial_dim, 16);
+    let cache = dir.0.join("cache");
+    let (_, first) = experiments::train::training_data(&c, &cache).unwrap();
+    let files: Vec<_> =
+        std::fs::read_dir(&cache).unwrap().map(|e| e.unwrap().file_name()).collect();
+    let table = files.iter().find(|f| f.to_string_lossy().starts_with("lbo-table-"));
+    assert!(table.is_some(), "{files:?}");
+    let (_, again) = experiments::train::training_data(&c, &cache).unwrap();
+    assert_eq!(first.spatial, again.spatial);
+    assert_eq!(first.spatial.len(), first.len() * 16);
+    // Eigenfunctions are divided by their range: interpolated values lie within [-1, 1].
+    assert!(first.spatial.iter().all(|v| v.is_finite() && v.abs() <= 1.0 + 1e-5));
+    // The features vary over the surface (not a constant column).
+    let col0: Vec<f32> = first.spatial.iter().step_by(16).copied().collect();
+    let (lo, hi) = col0.iter().fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+    assert!(hi - lo > 0.1, "{lo} {hi}");
+}
