@@ -96,9 +96,14 @@ fn prepare_run_dir(config: &RunConfig, run: &Path) -> Result<Option<RunMetrics>>
     if path.is_file() {
         let existing = RunConfig::read(&path)?;
         if existing != *config {
+            let keys = differing_keys(&existing, config);
             return Err(Error::format(
                 &path,
-                "the run directory holds a different configuration (use a new run directory)",
+                format!(
+                    "the run directory holds a different configuration (keys {}); use a new \
+                     run directory",
+                    keys.join(", ")
+                ),
             ));
         }
         if run.join(WEIGHTS_FILE).is_file() && run.join(METRICS_FILE).is_file() {
@@ -108,6 +113,30 @@ fn prepare_run_dir(config: &RunConfig, run: &Path) -> Result<Option<RunMetrics>>
         write_atomic(&path, config.to_toml()?.as_bytes())?;
     }
     Ok(None)
+}
+
+/// Dotted keys whose values differ between two configurations.
+fn differing_keys(a: &RunConfig, b: &RunConfig) -> Vec<String> {
+    fn walk(prefix: &str, a: &toml::Value, b: &toml::Value, out: &mut Vec<String>) {
+        match (a, b) {
+            (toml::Value::Table(x), toml::Value::Table(y)) => {
+                let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
+                for k in keys {
+                    let key = if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") };
+                    match (x.get(k), y.get(k)) {
+                        (Some(p), Some(q)) => walk(&key, p, q, out),
+                        _ => out.push(key),
+                    }
+                }
+            }
+            _ if a != b => out.push(prefix.to_string()),
+            _ => {}
+        }
+    }
+    let table = |c: &RunConfig| toml::Value::try_from(c).unwrap_or(toml::Value::Boolean(false));
+    let mut out = Vec::new();
+    walk("", &table(a), &table(b), &mut out);
+    out
 }
 
 /// The batch generator of `step`: a function of (seed, step) only.
