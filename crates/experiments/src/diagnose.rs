@@ -58,7 +58,13 @@ pub fn diagnose(model: &BrdfModel) -> String {
         .map(|h| format!("{} ({} non-finite)", h.path, h.non_finite))
         .collect();
     if !bad.is_empty() {
-        return format!("non-finite parameters in {}", bad.join(", "));
+        const SHOWN: usize = 4;
+        let more = bad.len().saturating_sub(SHOWN);
+        let mut list = bad[..bad.len().min(SHOWN)].join(", ");
+        if more > 0 {
+            list.push_str(&format!(" and {more} more of {} groups", health.len()));
+        }
+        return format!("non-finite parameters in {list}");
     }
     match health.iter().max_by(|a, b| a.max_abs.total_cmp(&b.max_abs)) {
         Some(h) => format!(
