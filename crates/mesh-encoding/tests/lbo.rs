@@ -310,3 +310,17 @@ fn spot_eigenpairs_and_encoding() {
     // The default configuration needs 513 pairs.
     assert!(LboEncoding::new(&pairs, &LboEncodingConfig::default()).is_err());
 }
+
+#[test]
+fn many_pairs_on_a_small_mesh_use_the_dense_solver() {
+    // 150 pairs of a 642-vertex mesh: half the vertex count cannot hold the ~3 k vectors block
+    // Lanczos needs, so the solver answers with the dense one (it used to fail to converge,
+    // as 513 pairs did on spot's 2,930 vertices).
+    let (v, f) = icosphere(3);
+    let m = LboMatrices::assemble(&v, &f).unwrap();
+    let (pairs, report) = smallest_eigenpairs(&m, 150, &EigenSettings::default()).unwrap();
+    assert!(report.dense);
+    let dense = dense_eigenpairs(&m, 150).unwrap();
+    assert_eq!(pairs.values, dense.values);
+    assert!(pairs.orthonormality_error(&m.mass) < 1e-8);
+}

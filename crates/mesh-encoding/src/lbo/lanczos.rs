@@ -16,8 +16,6 @@
 use std::time::Instant;
 
 use faer::linalg::matmul::matmul;
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::Llt;
 use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
 
 use super::eigen::{EigenSettings, SplitMix64, orthonormalize_block};
@@ -220,7 +218,7 @@ pub(crate) fn worst_ratio(ritz: &Ritz, k: usize, tolerance: f64) -> f64 {
 /// [`Error::Lbo`] when the basis limit is reached before convergence or a dense eigen fails.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn block_lanczos(
-    llt: &Llt<usize, f64>,
+    llt: &super::factor::CholeskyFactor,
     sqrt_m: &[f64],
     k: usize,
     b: usize,

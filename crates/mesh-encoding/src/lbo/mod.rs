@@ -24,6 +24,7 @@ pub mod assembly;
 pub mod cache;
 pub mod eigen;
 pub mod encoding;
+mod factor;
 mod lanczos;
 mod slicing;
 
