@@ -45,10 +45,14 @@ proptest! {
         let r = Rusinkiewicz { theta_h: th, theta_d: td, phi_d: pd };
         let (l, v) = r.to_local();
         let back = Rusinkiewicz::from_local(l, v);
-        prop_assert!((back.theta_h - th).abs() < 1e-12);
         prop_assert!((back.theta_d - td).abs() < 1e-12);
-        if td > 1e-6 && th > 1e-6 {
-            prop_assert!(angle_dist(back.phi_d, pd) < 1e-9);
+        // As theta_d -> pi/2, l -> -v and the half vector (hence theta_h and phi_d) is defined
+        // only to about eps / (2 cos theta_d): compare where that is below the bound.
+        if td.cos() > 1e-3 {
+            prop_assert!((back.theta_h - th).abs() < 1e-12, "theta_h {} vs {th}", back.theta_h);
+            if td > 1e-6 && th > 1e-6 {
+                prop_assert!(angle_dist(back.phi_d, pd) < 1e-9);
+            }
         }
     }
 
