@@ -47,6 +47,9 @@ pub use batch::eval_batch;
 pub use batch::par_eval_batch;
 pub use brdf::{Brdf, Rgb};
 pub use disney::{Disney, DisneyParams};
+/// FMBRDF's frame helpers, shared with its tensor twin: the body network's input features
+/// (view-aligned frame of the addendum) and the clamped tan(theta) of the Smith network.
+pub use fmbrdf::geometry::{body_features as fmbrdf_body_features, smith_tan as fmbrdf_smith_tan};
 /// The FMBRDF normalisation rule: Gauss-Legendre nodes and the tail truncation (see [`Fmbrdf`]).
 pub use fmbrdf::quadrature::{
     NODES as FMBRDF_NORMALIZATION_NODES, TAIL as FMBRDF_NORMALIZATION_TAIL,

@@ -13,7 +13,7 @@ pub(crate) const DEN_EPS: f64 = 1e-9;
 /// tan(arccos(clamp(c, 1e-6, 1 - 1e-6))), computed as sqrt((1 - c)(1 + c)) / c (exact in
 /// exact arithmetic, free of the cancellation of 1 - c^2 and of acos near 1). At most ~1e6.
 #[inline]
-pub(crate) fn smith_tan<T: Real>(cos: T) -> T {
+pub fn smith_tan<T: Real>(cos: T) -> T {
     let c = cos.max(T::lit(COS_EPS)).min(T::lit(1.0 - COS_EPS));
     ((T::one() - c) * (T::one() + c)).sqrt() / c
 }
@@ -52,7 +52,7 @@ pub(crate) fn fresnel<T: Real>(cos_r: T, eta: T) -> T {
 /// l'' = (hypot(l'_x, l'_y), 0, l'_z); when l' lies on the z axis (l = v) the angle is
 /// atan2(0, 0) = 0 and the rotation is the identity, as in the official code.
 #[inline]
-pub(crate) fn body_features<T: Real>(l: Vec3<T>, v: Vec3<T>) -> [T; 6] {
+pub fn body_features<T: Real>(l: Vec3<T>, v: Vec3<T>) -> [T; 6] {
     let u = [-v[0], -v[1], -v[2]];
     let rho = u[0].hypot(u[2]);
     let (cy, sy) = if rho > T::zero() { (u[2] / rho, u[0] / rho) } else { (T::one(), T::zero()) };

@@ -1,6 +1,6 @@
 //! The Fresnel Microfacet BRDF (FMBRDF) with its two pretrained helper networks.
 
-mod geometry;
+pub(crate) mod geometry;
 mod network;
 pub(crate) mod quadrature;
 mod weights;

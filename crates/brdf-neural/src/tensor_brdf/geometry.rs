@@ -154,12 +154,6 @@ fn unit(w: Vec3<f32>) -> Option<Vec3<f32>> {
     if (len2 - 1.0).abs() <= 16.0 * f32::EPSILON { Some(w) } else { angles::vec3::try_normalize(w) }
 }
 
-/// tan(theta) from cos(theta), clamped like the official code.
-pub(crate) fn smith_tan(cos: f32) -> f32 {
-    let c = cos.max(COS_EPS as f32).min((1.0 - COS_EPS) as f32);
-    ((1.0 - c) * (1.0 + c)).sqrt() / c
-}
-
 /// The 15 FMBRDF geometry values of a valid pair, in the column order of [`FmbrdfGeometry`].
 fn fm_terms(l: Vec3<f32>, v: Vec3<f32>) -> [f32; N_FM] {
     let (nl, nv) = (l[2].min(1.0), v[2].min(1.0));
@@ -192,22 +186,8 @@ fn fm_terms(l: Vec3<f32>, v: Vec3<f32>) -> [f32; N_FM] {
     ]
 }
 
-/// The body-reflection network's frame (spec addendum): rotate so that -v is +z, then about z
-/// so that l has no y component. Returns (n''_x, n''_y, n''_z, l''_x, l''_z, n''.l'').
-pub(crate) fn body_features(l: Vec3<f32>, v: Vec3<f32>) -> [f32; 6] {
-    let u = [-v[0], -v[1], -v[2]];
-    let rho = u[0].hypot(u[2]);
-    let (cy, sy) = if rho > 0.0 { (u[2] / rho, u[0] / rho) } else { (1.0, 0.0) };
-    let n1 = [-sy, -u[1] * cy, u[2]];
-    let d = [l[0] - v[0], l[1] - v[1], l[2] - v[2]];
-    let l1 = [
-        cy * d[0] - sy * d[2],
-        -u[1] * (sy * d[0] + cy * d[2]) + rho * d[1],
-        u[0] * l[0] + u[1] * l[1] + u[2] * l[2],
-    ];
-    let r = l1[0].hypot(l1[1]);
-    let (cp, sp) = if r > 0.0 { (l1[0] / r, l1[1] / r) } else { (1.0, 0.0) };
-    let n2 = [cp * n1[0] + sp * n1[1], -sp * n1[0] + cp * n1[1], n1[2]];
-    let nl = n2[0] * r + n2[2] * l1[2];
-    [n2[0], n2[1], n2[2], r, l1[2], nl]
-}
+/// The body-reflection network's frame (spec addendum), shared with the scalar model: rotate so
+/// that -v is +z, then about z so that l has no y component.
+pub(crate) use brdf_analytic::fmbrdf_body_features as body_features;
+/// tan(theta) from cos(theta), clamped like the official code (shared with the scalar model).
+pub(crate) use brdf_analytic::fmbrdf_smith_tan as smith_tan;
