@@ -11,8 +11,7 @@ use crate::loss::srgb_oetf;
 use crate::{Error, Result};
 use angles::Frame;
 use dataset_merl::{SampleSet, SceneDataset};
-use mesh_encoding::lbo::dense_eigenpairs;
-use mesh_encoding::{EigenSettings, LboEncoding, LboMatrices, cached_eigenpairs};
+use mesh_encoding::{EigenSettings, LboEncoding, cached_eigenpairs};
 use std::path::Path;
 
 /// Samples ready for batching, struct of arrays.
@@ -191,12 +190,8 @@ fn eigen_settings(features: &FeatureConfig) -> EigenSettings {
     EigenSettings { max_basis_factor: features.lbo.max_basis_factor, ..EigenSettings::default() }
 }
 
-/// Largest mesh (vertices) solved densely when the iterative eigensolver fails.
-pub const DENSE_LIMIT: usize = 6000;
-
-/// The LBO encoding of the scene's mesh with the configured selection: eigenpairs from the
-/// cache (iterative solver), or, when that solver fails on a mesh of at most [`DENSE_LIMIT`]
-/// vertices, from the dense solver.
+/// The LBO encoding of the scene's mesh with the configured selection, eigenpairs from the
+/// content-keyed cache (mesh-encoding picks the dense solver itself for small meshes).
 pub fn lbo_encoding(
     scene: &SceneDataset,
     features: &FeatureConfig,
@@ -208,15 +203,6 @@ pub fn lbo_encoding(
     std::fs::create_dir_all(cache_dir).map_err(|e| Error::io(cache_dir, e))?;
     let k = config.required_pairs();
     let settings = eigen_settings(features);
-    let pairs = match cached_eigenpairs(&vertices, &scene.mesh.triangles, k, &settings, cache_dir) {
-        Ok((pairs, _)) => pairs,
-        // The iterative solver's basis is capped at half the vertex count, too small for
-        // k = 513 on meshes of a few thousand vertices: solve those densely (not cached).
-        Err(_) if vertices.len() <= DENSE_LIMIT && k <= vertices.len() => {
-            let matrices = LboMatrices::assemble(&vertices, &scene.mesh.triangles)?;
-            dense_eigenpairs(&matrices, k)?
-        }
-        Err(e) => return Err(e.into()),
-    };
+    let (pairs, _) = cached_eigenpairs(&vertices, &scene.mesh.triangles, k, &settings, cache_dir)?;
     Ok(LboEncoding::new(&pairs, &config)?)
 }
