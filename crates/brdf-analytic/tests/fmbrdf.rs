@@ -251,9 +251,9 @@ fn stress_finite_and_nonnegative() {
                     1 => near_mirror(&mut rng, p.alpha),
                     2 => {
                         // Grazing light, polar cosine down to 1e-12.
-                        let z = 10f64.powf(-12.0 * rng.uniform());
+                        let z = 10f64.powf(-12.0 * rng.next_f64());
                         let v = hemisphere(&mut rng);
-                        let phi = TAU * rng.uniform();
+                        let phi = TAU * rng.next_f64();
                         let r = (1.0 - z * z).sqrt();
                         ([r * phi.cos(), r * phi.sin(), z], v)
                     }

@@ -4,27 +4,8 @@ use super::reference::RefParams;
 use brdf_analytic::{FmbrdfParams, Real};
 use std::f64::consts::TAU;
 
-/// SplitMix64: a tiny, well-mixed, seeded generator (the tests need reproducibility, not crypto).
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    pub fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-}
+/// The crate's seeded SplitMix64 generator (`next_f64` is uniform in [0, 1)).
+pub use brdf_analytic::albedo::SplitMix64 as Rng;
 
 /// Maps `f` over `items` on all available cores (scoped threads), keeping the order.
 pub fn par_map<I: Sync, O: Send>(items: &[I], f: impl Fn(&I) -> O + Sync) -> Vec<O> {
@@ -39,17 +20,15 @@ pub fn par_map<I: Sync, O: Send>(items: &[I], f: impl Fn(&I) -> O + Sync) -> Vec
 
 /// Uniform direction on the upper hemisphere (uniform in solid angle).
 pub fn hemisphere(rng: &mut Rng) -> [f64; 3] {
-    let z = rng.uniform();
-    let phi = TAU * rng.uniform();
+    let z = rng.next_f64();
+    let phi = TAU * rng.next_f64();
     let r = (1.0 - z * z).max(0.0).sqrt();
     [r * phi.cos(), r * phi.sin(), z]
 }
 
 /// Cosine-weighted direction on the upper hemisphere (Malley's method).
 pub fn cosine_hemisphere(rng: &mut Rng) -> [f64; 3] {
-    let (u1, u2) = (rng.uniform(), rng.uniform());
-    let r = u1.sqrt();
-    [r * (TAU * u2).cos(), r * (TAU * u2).sin(), (1.0 - u1).sqrt()]
+    brdf_analytic::albedo::cosine_sample(rng.next_f64(), rng.next_f64())
 }
 
 pub fn normalize(a: [f64; 3]) -> [f64; 3] {
@@ -67,15 +46,15 @@ pub fn quantile(values: &mut [f64], q: f64) -> f64 {
 /// each at one of its ends with probability 0.1 per end.
 pub fn random_params(rng: &mut Rng) -> RefParams {
     let mut pick = |lo: f64, hi: f64, log: bool| {
-        let u = rng.uniform();
+        let u = rng.next_f64();
         if u < 0.1 {
             lo
         } else if u > 0.9 {
             hi
         } else if log {
-            (lo.ln() + (hi.ln() - lo.ln()) * rng.uniform()).exp()
+            (lo.ln() + (hi.ln() - lo.ln()) * rng.next_f64()).exp()
         } else {
-            lo + (hi - lo) * rng.uniform()
+            lo + (hi - lo) * rng.next_f64()
         }
     };
     RefParams {
@@ -102,8 +81,8 @@ pub fn params_t<T: Real>(p: &RefParams) -> FmbrdfParams<T> {
 /// A pair near the mirror configuration (h within ~2 alpha of n), so the specular term matters.
 pub fn near_mirror(rng: &mut Rng, alpha: f64) -> ([f64; 3], [f64; 3]) {
     let v = hemisphere(rng);
-    let t = (2.0 * alpha * rng.uniform()).min(1.2);
-    let phi = TAU * rng.uniform();
+    let t = (2.0 * alpha * rng.next_f64()).min(1.2);
+    let phi = TAU * rng.next_f64();
     let h = normalize([t.sin() * phi.cos(), t.sin() * phi.sin(), t.cos()]);
     let vh = v[0] * h[0] + v[1] * h[1] + v[2] * h[2];
     (normalize([2.0 * vh * h[0] - v[0], 2.0 * vh * h[1] - v[1], 2.0 * vh * h[2] - v[2]]), v)

@@ -44,29 +44,22 @@ pub struct Sensor {
     pub seed: u64,
 }
 
-/// SplitMix64 normal deviates (Box-Muller), deterministic per seed.
+/// Normal deviates (Box-Muller) from the crate-wide SplitMix64, deterministic per seed.
 struct Normal {
-    state: u64,
+    rng: brdf_analytic::albedo::SplitMix64,
     spare: Option<f64>,
 }
 
 impl Normal {
     fn new(seed: u64) -> Self {
-        Self { state: seed, spare: None }
-    }
-    fn uniform(&mut self) -> f64 {
-        self.state = self.state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        Self { rng: brdf_analytic::albedo::SplitMix64::new(seed), spare: None }
     }
     fn sample(&mut self) -> f64 {
         if let Some(s) = self.spare.take() {
             return s;
         }
-        let u1 = self.uniform().max(f64::MIN_POSITIVE);
-        let u2 = self.uniform();
+        let u1 = self.rng.next_f64().max(f64::MIN_POSITIVE);
+        let u2 = self.rng.next_f64();
         let r = (-2.0 * u1.ln()).sqrt();
         let (s, c) = (std::f64::consts::TAU * u2).sin_cos();
         self.spare = Some(r * s);
