@@ -35,6 +35,20 @@ pub struct LboMatrices {
 }
 
 impl LboMatrices {
+    /// The product `L X` of the stiffness matrix with a dense block of columns.
+    pub fn stiffness_times(&self, x: faer::MatRef<'_, f64>, par: faer::Par) -> faer::Mat<f64> {
+        let mut out = faer::Mat::<f64>::zeros(x.nrows(), x.ncols());
+        faer::sparse::linalg::matmul::sparse_dense_matmul(
+            out.as_mut(),
+            faer::Accum::Replace,
+            self.stiffness.as_ref(),
+            x,
+            1.0,
+            par,
+        );
+        out
+    }
+
     /// Assembles `L` and `M` from vertex positions and triangles.
     ///
     /// # Errors

@@ -136,15 +136,7 @@ impl Eigenpairs {
     /// of every pair (the `M^-1` norm is the Euclidean norm of the standard form `D L D`).
     pub fn relative_residuals(&self, matrices: &LboMatrices) -> Vec<f64> {
         let scale = weyl_spacing(matrices);
-        let mut lphi = Mat::<f64>::zeros(self.vertex_count(), self.len());
-        faer::sparse::linalg::matmul::sparse_dense_matmul(
-            lphi.as_mut(),
-            Accum::Replace,
-            matrices.stiffness.as_ref(),
-            self.vectors.as_ref(),
-            1.0,
-            Par::Seq,
-        );
+        let lphi = matrices.stiffness_times(self.vectors.as_ref(), Par::Seq);
         (0..self.len())
             .map(|j| {
                 let lambda = self.values[j];
@@ -438,15 +430,7 @@ fn finish(
             *x *= di;
         }
     }
-    let mut lphi = Mat::<f64>::zeros(n, k);
-    faer::sparse::linalg::matmul::sparse_dense_matmul(
-        lphi.as_mut(),
-        Accum::Replace,
-        matrices.stiffness.as_ref(),
-        phi.as_ref(),
-        1.0,
-        par,
-    );
+    let lphi = matrices.stiffness_times(phi.as_ref(), par);
     let values: Vec<f64> = (0..k)
         .map(|j| {
             let num: f64 =

@@ -364,15 +364,7 @@ fn global_rayleigh_ritz(
     // Z = X W, W = U_keep diag(g^-1/2): M-orthonormal.
     let wmat =
         Mat::<f64>::from_fn(kk, keep.len(), |i, j| ge.U()[(i, keep[j])] / gs[keep[j]].sqrt());
-    let mut lx = Mat::<f64>::zeros(n, kk);
-    faer::sparse::linalg::matmul::sparse_dense_matmul(
-        lx.as_mut(),
-        Accum::Replace,
-        matrices.stiffness.as_ref(),
-        x.as_ref(),
-        1.0,
-        par,
-    );
+    let lx = matrices.stiffness_times(x.as_ref(), par);
     let mut xlx = Mat::<f64>::zeros(kk, kk);
     matmul(xlx.as_mut(), Accum::Replace, x.transpose(), &lx, 1.0, par);
     drop(lx);
