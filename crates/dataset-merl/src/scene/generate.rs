@@ -19,7 +19,7 @@
 
 use super::config::{MaterialSpec, SceneConfig};
 use super::manifest::{
-    FileEntry, LightInfo, MANIFEST_FILE, Manifest, SceneStats, Split, VERSION, ViewInfo, hash_hex,
+    FileEntry, LightInfo, MANIFEST_FILE, Manifest, SceneStats, Split, VERSION, ViewInfo,
 };
 use super::render::{GroundTruth, Sensor, flag, render_light};
 use super::{images, mesh_file};
@@ -159,23 +159,18 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
         };
         let (geometry, _) = precompute_cached(&mesh, &views, &settings, &tmp.join("geometry"))?;
         let mut files = Mutex::new(Vec::new());
-        let mut record = |rel: String, bytes: &[u8]| -> Result<()> {
-            let path = tmp.join(&rel);
-            std::fs::write(&path, bytes).map_err(|e| Error::io(&path, e))?;
-            let entry = FileEntry { path: rel, bytes: bytes.len() as u64, xxh3: hash_hex(bytes) };
-            files.get_mut().unwrap().push(entry);
-            Ok(())
-        };
-        record("mesh.ply".into(), &mesh_file::ply_bytes(&mesh))?;
+        let mesh_bytes = mesh_file::ply_bytes(&mesh);
+        let mesh_path = tmp.join("mesh.ply");
+        std::fs::write(&mesh_path, &mesh_bytes).map_err(|e| Error::io(&mesh_path, e))?;
+        files.get_mut().unwrap().push(FileEntry::of("mesh.ply".into(), &mesh_bytes));
         for (vi, vp) in geometry.views.iter().enumerate() {
             let mut mask = vec![0u8; (vp.width * vp.height) as usize];
             for &p in &vp.pixels {
                 mask[p as usize] = 255;
             }
             let rel = format!("masks/v{vi:02}.png");
-            images::write_png_gray(&tmp.join(&rel), vp.width, vp.height, &mask)?;
-            let bytes = std::fs::read(tmp.join(&rel)).map_err(|e| Error::io(tmp.join(&rel), e))?;
-            record(rel, &bytes)?;
+            let bytes = images::write_png_gray(&tmp.join(&rel), vp.width, vp.height, &mask)?;
+            files.get_mut().unwrap().push(FileEntry::of(rel, &bytes));
         }
 
         let jobs: Vec<(usize, usize)> =
@@ -204,29 +199,20 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
             let img = render_light(vp, li, s.light_intensity, gt.as_ref(), sensor);
             let (w, h) = (vp.width as usize, vp.height as usize);
             let stem = sample_stem(vi, li);
-            let mut out_files = Vec::with_capacity(3);
+            let mut entries = Vec::with_capacity(4);
             for (dir, data) in [("images", &img.observed), ("brdf", &img.brdf)] {
                 let rel = format!("{dir}/{stem}.exr");
-                images::write_exr_rgb(&tmp.join(&rel), w, h, data)?;
-                out_files.push(rel);
+                let bytes = images::write_exr_rgb(&tmp.join(&rel), w, h, data)?;
+                entries.push(FileEntry::of(rel, &bytes));
             }
             let rel = format!("flags/{stem}.png");
-            images::write_png_gray(&tmp.join(&rel), vp.width, vp.height, &img.flags)?;
-            out_files.push(rel);
+            let bytes = images::write_png_gray(&tmp.join(&rel), vp.width, vp.height, &img.flags)?;
+            entries.push(FileEntry::of(rel, &bytes));
             if li == 0 {
                 let rel = format!("previews/v{vi:02}.png");
-                images::write_png_srgb(&tmp.join(&rel), vp.width, vp.height, &img.observed)?;
-                out_files.push(rel);
-            }
-            let mut entries = Vec::with_capacity(3);
-            for rel in out_files {
-                let path = tmp.join(&rel);
-                let bytes = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
-                entries.push(FileEntry {
-                    path: rel,
-                    bytes: bytes.len() as u64,
-                    xxh3: hash_hex(&bytes),
-                });
+                let bytes =
+                    images::write_png_srgb(&tmp.join(&rel), vp.width, vp.height, &img.observed)?;
+                entries.push(FileEntry::of(rel, &bytes));
             }
             files.lock().unwrap().extend(entries);
             let mut st = stats.lock().unwrap();

@@ -5,12 +5,39 @@ use crate::error::{Error, Result};
 use exr::prelude::*;
 use std::path::Path;
 
+/// Writes encoded bytes to `path` and hands them back (the generator hashes them without
+/// reading the file again).
+fn write_bytes(path: &Path, bytes: Vec<u8>) -> Result<Vec<u8>> {
+    std::fs::write(path, &bytes).map_err(|e| Error::io(path, e))?;
+    Ok(bytes)
+}
+
+/// Encodes an image with the `image` crate into memory.
+fn encode_png(
+    path: &Path,
+    data: &[u8],
+    width: u32,
+    height: u32,
+    color: image::ExtendedColorType,
+) -> Result<Vec<u8>> {
+    let mut buf = std::io::Cursor::new(Vec::new());
+    image::write_buffer_with_format(&mut buf, data, width, height, color, image::ImageFormat::Png)
+        .map_err(|e| image_err(path, e))?;
+    Ok(buf.into_inner())
+}
+
 fn image_err(path: &Path, e: impl std::fmt::Display) -> Error {
     Error::Image { path: path.into(), fault: e.to_string() }
 }
 
-/// Writes a row-major RGB f32 image as an EXR file (ZIP compression, lossless).
-pub fn write_exr_rgb(path: &Path, width: usize, height: usize, rgb: &[[f32; 3]]) -> Result<()> {
+/// Writes a row-major RGB f32 image as an EXR file (ZIP compression, lossless); returns the
+/// bytes written.
+pub fn write_exr_rgb(
+    path: &Path,
+    width: usize,
+    height: usize,
+    rgb: &[[f32; 3]],
+) -> Result<Vec<u8>> {
     if rgb.len() != width * height {
         return Err(image_err(path, format!("{} pixels for {width} x {height}", rgb.len())));
     }
@@ -18,11 +45,13 @@ pub fn write_exr_rgb(path: &Path, width: usize, height: usize, rgb: &[[f32; 3]])
         let p: [f32; 3] = rgb[y * width + x];
         (p[0], p[1], p[2])
     });
+    let mut buf = std::io::Cursor::new(Vec::new());
     Image::from_encoded_channels((width, height), Encoding::SMALL_LOSSLESS, channels)
         .write()
         .non_parallel()
-        .to_file(path)
-        .map_err(|e| image_err(path, e))
+        .to_buffered(&mut buf)
+        .map_err(|e| image_err(path, e))?;
+    write_bytes(path, buf.into_inner())
 }
 
 /// Reads an RGB EXR file: (width, height, row-major pixels). Non-finite values are an error.
@@ -52,10 +81,9 @@ pub fn read_exr_rgb(path: &Path) -> Result<(usize, usize, Vec<[f32; 3]>)> {
     Ok((size.0, size.1, px))
 }
 
-/// Writes an 8-bit grayscale PNG.
-pub fn write_png_gray(path: &Path, width: u32, height: u32, data: &[u8]) -> Result<()> {
-    image::save_buffer(path, data, width, height, image::ExtendedColorType::L8)
-        .map_err(|e| image_err(path, e))
+/// Writes an 8-bit grayscale PNG; returns the bytes written.
+pub fn write_png_gray(path: &Path, width: u32, height: u32, data: &[u8]) -> Result<Vec<u8>> {
+    write_bytes(path, encode_png(path, data, width, height, image::ExtendedColorType::L8)?)
 }
 
 /// Reads an 8-bit grayscale PNG: (width, height, data).
@@ -78,9 +106,9 @@ pub fn srgb8(linear: f32) -> u8 {
     (s * 255.0 + 0.5) as u8
 }
 
-/// Writes a linear RGB image as an 8-bit sRGB PNG (values clamped to [0, 1]), for viewing.
-pub fn write_png_srgb(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<()> {
+/// Writes a linear RGB image as an 8-bit sRGB PNG (values clamped to [0, 1]), for viewing;
+/// returns the bytes written.
+pub fn write_png_srgb(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<Vec<u8>> {
     let bytes: Vec<u8> = rgb.iter().flat_map(|p| p.map(srgb8)).collect();
-    image::save_buffer(path, &bytes, width, height, image::ExtendedColorType::Rgb8)
-        .map_err(|e| image_err(path, e))
+    write_bytes(path, encode_png(path, &bytes, width, height, image::ExtendedColorType::Rgb8)?)
 }

@@ -67,6 +67,13 @@ pub struct FileEntry {
     pub xxh3: String,
 }
 
+impl FileEntry {
+    /// The entry of a file at `path` (relative) with these contents.
+    pub fn of(path: String, bytes: &[u8]) -> Self {
+        Self { path, bytes: bytes.len() as u64, xxh3: hash_hex(bytes) }
+    }
+}
+
 /// Counts over all (foreground pixel, light) samples.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
