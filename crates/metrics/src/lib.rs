@@ -17,6 +17,7 @@
 
 pub mod aggregate;
 mod batch;
+pub mod colormap;
 pub mod energy;
 mod error;
 pub mod flip;
