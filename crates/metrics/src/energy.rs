@@ -11,20 +11,32 @@
 //! Two estimators:
 //! * [`Estimator::MonteCarlo`]: the paper's protocol, N i.i.d. samples per pair (paper: 20,000,
 //!   with 50,000 pairs); the error bar is the sample standard error.
-//! * [`Estimator::Sobol`]: randomized quasi-Monte Carlo, the 2D Sobol (0, 2)-sequence with
-//!   independent random digital shifts per replica; the error bar is the standard error over the
-//!   replicas; the point count per replica doubles until every channel's error bar is at most
-//!   `tolerance` or lies `decision_sigmas` error bars below 1 (its verdict "not above 1" is then
-//!   settled and it cannot be a violating pair's largest channel), or `max_points` is reached.
-//!   The integrand is smooth in (u1, u2) for the models
-//!   here, so far fewer evaluations reach the same error bar.
+//! * [`Estimator::Sobol`]: randomized quasi-Monte Carlo with importance sampling. Each replica
+//!   draws the same number of 2D Sobol (0, 2)-sequence points, with its own random digital
+//!   shift, from every component of a defensive mixture (the cosine density and Phong lobes of
+//!   growing sharpness about the mirror direction; see [`mixture`]) and combines them with the
+//!   balance heuristic, so the estimate is unbiased for any model. The error bar is the
+//!   standard error over the replicas; the point count per replica doubles until every
+//!   channel's error bar is at most `tolerance` or lies `decision_sigmas` error bars below 1
+//!   (its verdict "not above 1" is then settled and it cannot be a violating pair's largest
+//!   channel), or `max_points` is reached.
+//!
+//! Why the mixture: with cosine samples alone a glossy peak is missed by most samples, and at
+//! Torrance-Sparrow roughness below about 0.3 even the paper's 20,000 samples give estimates
+//! and error bars that are off by several error bars (the tests measure this against an
+//! independent GGX-sampled reference); a cosine-only RQMC with few points fails worse, because
+//! replicas that all miss the peak agree with each other. With the mixture, 3,584 evaluations a
+//! pair give error bars 10 to 1000 times smaller than the paper's 20,000.
 //!
 //! Deterministic for a seed (each pair's random numbers depend only on the seed and the pair's
 //! position), parallel with rayon when the model allows, with an optional progress bar.
 
+pub mod mixture;
+
 use crate::batch::BatchBrdf;
 use crate::error::{Error, Result};
 use indicatif::{ProgressBar, ProgressStyle};
+use mixture::{COMPONENTS, Mixture};
 use rand::{Rng, SeedableRng, rngs::StdRng};
 use rayon::prelude::*;
 use std::time::Instant;
@@ -50,9 +62,9 @@ pub enum Estimator {
     Sobol {
         /// Independent random shifts (replicas) (default 8).
         replicas: usize,
-        /// Initial points per replica, a power of two (default 64).
+        /// Initial points per replica and mixture component, a power of two (default 64).
         initial_points: usize,
-        /// Largest points per replica (default 2048).
+        /// Largest points per replica and component (default 2048).
         max_points: usize,
         /// Target standard error per channel (default 1e-3).
         tolerance: f64,
@@ -249,24 +261,26 @@ fn sobol_group(
     batch: usize,
 ) -> Vec<PairEnergy> {
     let np = pairs.len();
+    let mixtures: Vec<Mixture> = pairs.iter().map(|(_, p)| Mixture::new(p.l)).collect();
+    // One random digital shift per pair, replica and mixture component.
     let shifts: Vec<Vec<(u32, u32)>> = pairs
         .iter()
         .map(|(i, _)| {
             let mut rng = pair_rng(seed, *i);
-            (0..replicas).map(|_| (rng.random(), rng.random())).collect()
+            (0..replicas * COMPONENTS).map(|_| (rng.random(), rng.random())).collect()
         })
         .collect();
-    // Per pair and replica: running sums of f per channel.
+    // Per pair and replica: running sums of f cos / sum_j p_j per channel.
     let mut sums = vec![vec![[0.0f64; 3]; replicas]; np];
     let mut points = vec![0usize; np];
     let mut result: Vec<Option<PairEnergy>> = vec![None; np];
-    let pi = std::f64::consts::PI;
+    // Replica estimates (sum / m) -> their mean and standard error.
     let estimate = |s: &[[f64; 3]], m: usize| -> ([f64; 3], [f64; 3]) {
         let r = s.len() as f64;
         let mut e = [0.0; 3];
         let mut se = [0.0; 3];
         for c in 0..3 {
-            let vals: Vec<f64> = s.iter().map(|x| pi * x[c] / m as f64).collect();
+            let vals: Vec<f64> = s.iter().map(|x| x[c] / m as f64).collect();
             let mean = vals.iter().sum::<f64>() / r;
             let var = if s.len() > 1 {
                 vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (r - 1.0)
@@ -286,29 +300,39 @@ fn sobol_group(
         let (mut pts, mut ls, mut vs, mut owner) = (vec![], vec![], vec![], vec![]);
         for &j in &active {
             let (from, to) = if points[j] == 0 { (0, initial) } else { (points[j], 2 * points[j]) };
-            for (r, &(s1, s2)) in shifts[j].iter().enumerate() {
-                for i in from..to {
-                    let (x, y) = sobol2(i as u32);
-                    pts.push(pairs[j].1.point);
-                    ls.push(pairs[j].1.l);
-                    vs.push(cosine_direction(unit(x ^ s1), unit(y ^ s2)));
-                    owner.push((j, r));
+            let mix = &mixtures[j];
+            for r in 0..replicas {
+                for k in 0..COMPONENTS {
+                    let (s1, s2) = shifts[j][r * COMPONENTS + k];
+                    for i in from..to {
+                        let (x, y) = sobol2(i as u32);
+                        let v = mix.sample(k, unit(x ^ s1), unit(y ^ s2));
+                        // The integrand's weight cos(theta_v) / sum_j p_j(v) (0 below the
+                        // horizon, where the lobes may reach).
+                        let w = if v[2] > 0.0 { v[2] / mix.density_sum(v) } else { 0.0 };
+                        pts.push(pairs[j].1.point);
+                        ls.push(pairs[j].1.l);
+                        vs.push(v.map(|c| c as f32));
+                        owner.push((j, r, w));
+                    }
                 }
             }
             points[j] = to;
         }
         let f = eval_chunked(brdf, &pts, &ls, &vs, batch);
-        for (fk, &(j, r)) in f.iter().zip(&owner) {
-            for c in 0..3 {
-                sums[j][r][c] += fk[c] as f64;
+        for (fk, &(j, r, w)) in f.iter().zip(&owner) {
+            if w > 0.0 {
+                for c in 0..3 {
+                    sums[j][r][c] += fk[c] as f64 * w;
+                }
             }
         }
         for &j in &active {
             let (energy, std_error) = estimate(&sums[j], points[j]);
             let settled = (0..3).all(|c| std_error[c] <= tol || energy[c] + z * std_error[c] < 1.0);
             if settled || points[j] >= max_points {
-                result[j] =
-                    Some(PairEnergy { energy, std_error, evaluations: points[j] * replicas });
+                let evaluations = points[j] * replicas * COMPONENTS;
+                result[j] = Some(PairEnergy { energy, std_error, evaluations });
             }
         }
     }
@@ -335,7 +359,7 @@ pub fn energy_conservation(
                 && max_points <= 1 << 31
                 && tolerance >= 0.0 =>
         {
-            replicas * initial_points
+            replicas * initial_points * COMPONENTS
         }
         e => return Err(Error::Config(format!("energy estimator {e:?}"))),
     };
