@@ -223,6 +223,12 @@ fn bad_inputs_are_clear_errors_and_leave_nothing_behind() {
     };
     let msg = generate_scene(&unknown, &out, false).unwrap_err().to_string();
     assert!(msg.contains("unobtainium"), "{msg}");
+    let captured = SceneConfig {
+        material: MaterialSpec::Captured { benchmark: "DiLiGenT".into(), object: "ball".into() },
+        ..lambert_config(sphere_over_plane(&dir.0))
+    };
+    let msg = generate_scene(&captured, &out, false).unwrap_err().to_string();
+    assert!(msg.contains("imported") && msg.contains("ball"), "{msg}");
     let msg = SceneConfig::from_json(r#"{"mesh": "m.obj", "material": {"kind": "lambert", "albedo": [0.5, 0.5, 0.5]}, "seed": 1, "settings": {"widht": 3}}"#)
         .unwrap_err()
         .to_string();

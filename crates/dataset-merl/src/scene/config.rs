@@ -21,6 +21,14 @@ pub enum MaterialSpec {
         /// Albedo, linear RGB in [0, 1].
         albedo: [f32; 3],
     },
+    /// A real capture imported from a benchmark (for example by `dataset-diligent`): the
+    /// material is unknown, there is no ground-truth BRDF, and the scene cannot be generated.
+    Captured {
+        /// The benchmark, for example "DiLiGenT" or "DiLiGenT-MV".
+        benchmark: String,
+        /// The object, for example "ball".
+        object: String,
+    },
 }
 
 /// Rendering settings of a scene.

@@ -115,6 +115,15 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
             let f = albedo.map(|a| a as f64 / std::f64::consts::PI);
             ("analytic (Lambert)".to_string(), Box::new(move |_, _| Some(f)))
         }
+        MaterialSpec::Captured { benchmark, object } => {
+            return Err(Error::Config {
+                key: "material".into(),
+                fault: format!(
+                    "captured data ({benchmark} {object}) is imported (dataset-diligent), \
+                     not generated"
+                ),
+            });
+        }
     };
 
     let orbit = raycast_precompute::scenes::orbit_views(
@@ -252,6 +261,7 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
                             direction: d.to_array(),
                             intensity: s.light_intensity,
                             split: split(li < s.train_lights),
+                            source_index: None,
                         })
                         .collect(),
                 }

@@ -37,6 +37,10 @@ pub struct LightInfo {
     pub intensity: [f32; 3],
     /// Split of this light within its view.
     pub split: Split,
+    /// For captured scenes: the light's 1-based image number in the source capture (absent in
+    /// generated scenes, whose manifests are unchanged by this field).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source_index: Option<u32>,
 }
 
 /// One camera view.
