@@ -71,6 +71,9 @@ pub struct RunConfig {
     pub features: FeatureConfig,
     /// Training schedule.
     pub train: TrainConfig,
+    /// What `eval` computes (defaults from the profile; see [`crate::eval::settings`]).
+    #[serde(default, skip_serializing_if = "crate::eval::EvalConfig::is_default")]
+    pub eval: crate::eval::EvalConfig,
 }
 
 /// Which defaults a run starts from.
@@ -384,6 +387,7 @@ impl RunConfig {
     /// Checks every range; errors name the key.
     pub fn validate(&self) -> Result<()> {
         self.train.validate()?;
+        self.eval.validate()?;
         if self.features.spatial == SpatialKind::Lbo {
             self.features.lbo.validate()?;
         }

@@ -1,0 +1,72 @@
+//! The BRDF-space analyses of a fitted model on its test records (spec section 7): energy
+//! conservation (directional albedo of random (x, l) pairs) and the reciprocity RMSE.
+
+use super::predict::ModelBrdf;
+use super::settings::EvalSettings;
+use crate::Result;
+use metrics::energy::{EnergyConfig, EnergyPair, energy_conservation, sample_pairs};
+use serde::{Deserialize, Serialize};
+
+/// The energy-conservation result of a run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EnergySummary {
+    /// `fast` or `paper`.
+    pub estimator: String,
+    /// (x, l) pairs analysed.
+    pub pairs: usize,
+    /// Percentage of pairs with some channel's albedo above 1.
+    pub percent_above_one: f64,
+    /// Median over violating pairs of their largest channel (`None`: no violation).
+    pub median_above_one: Option<f64>,
+    /// Mean standard error of the per-pair estimates (all channels).
+    pub mean_std_error: f64,
+    /// BRDF evaluations spent.
+    pub evaluations: u64,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+}
+
+/// Runs the configured energy analysis on `pairs` random test records (`None` when off).
+pub fn energy(
+    brdf: &ModelBrdf,
+    settings: &EvalSettings,
+    seed: u64,
+    progress: bool,
+) -> Result<Option<EnergySummary>> {
+    let Some(estimator) = settings.energy else { return Ok(None) };
+    let data = brdf.data;
+    if data.is_empty() {
+        return Ok(None);
+    }
+    let pairs: Vec<EnergyPair> = sample_pairs(data.len(), settings.energy_pairs, seed)
+        .into_iter()
+        .map(|i| EnergyPair { point: i as u32, l: data.l[i] })
+        .collect();
+    let report = energy_conservation(brdf, &pairs, &EnergyConfig { estimator, seed, progress })?;
+    let se: f64 = report.pairs.iter().flat_map(|p| p.std_error).sum();
+    Ok(Some(EnergySummary {
+        estimator: settings.energy_name.into(),
+        pairs: pairs.len(),
+        percent_above_one: report.percent_above_one,
+        median_above_one: report.median_above_one,
+        mean_std_error: se / (3 * report.pairs.len()).max(1) as f64,
+        evaluations: report.evaluations,
+        seconds: report.seconds,
+    }))
+}
+
+/// The reciprocity RMSE over the first `settings.reciprocity_pairs` test records spread over
+/// the whole set (every k-th), `None` when off.
+pub fn reciprocity(brdf: &ModelBrdf, settings: &EvalSettings) -> Result<Option<f64>> {
+    let data = brdf.data;
+    let n = settings.reciprocity_pairs.min(data.len());
+    if n == 0 {
+        return Ok(None);
+    }
+    let stride = data.len() / n;
+    let idx: Vec<usize> = (0..n).map(|i| i * stride).collect();
+    let points: Vec<u32> = idx.iter().map(|&i| i as u32).collect();
+    let l: Vec<[f32; 3]> = idx.iter().map(|&i| data.l[i]).collect();
+    let v: Vec<[f32; 3]> = idx.iter().map(|&i| data.v[i]).collect();
+    Ok(Some(metrics::reciprocity::reciprocity_rmse(brdf, &points, &l, &v)?))
+}
