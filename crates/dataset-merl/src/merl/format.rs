@@ -65,24 +65,34 @@ impl MerlBrdf {
     /// Non-finite values are an error; negative values are stored as they are (invalid).
     pub fn tabulate(origin: &str, f: impl Fn(f64, f64, f64) -> [f64; 3] + Sync) -> Result<Self> {
         use rayon::prelude::*;
-        let mut raw = vec![0.0; 3 * TABLE_LEN];
-        let (r, gb) = raw.split_at_mut(TABLE_LEN);
-        let (g, b) = gb.split_at_mut(TABLE_LEN);
-        r.par_chunks_mut(N_PHI_D)
-            .zip(g.par_chunks_mut(N_PHI_D))
-            .zip(b.par_chunks_mut(N_PHI_D))
-            .enumerate()
-            .for_each(|(row, ((r, g), b))| {
-                let (ih, id) = (row / N_THETA_D, row % N_THETA_D);
-                let (th, td, _) = crate::merl::lookup::bin_lower_edges(ih, id, 0);
-                for ip in 0..N_PHI_D {
-                    let pd = ip as f64 / N_PHI_D as f64 * std::f64::consts::PI;
-                    let v = f(th, td, pd);
-                    r[ip] = v[0] / CHANNEL_SCALES[0];
-                    g[ip] = v[1] / CHANNEL_SCALES[1];
-                    b[ip] = v[2] / CHANNEL_SCALES[2];
-                }
+        let values: Vec<[f64; 3]> = (0..TABLE_LEN)
+            .into_par_iter()
+            .map(|i| {
+                let (ih, id, ip) =
+                    (i / (N_THETA_D * N_PHI_D), (i / N_PHI_D) % N_THETA_D, i % N_PHI_D);
+                let (th, td, pd) = crate::merl::lookup::bin_lower_edges(ih, id, ip);
+                f(th, td, pd)
+            })
+            .collect();
+        Self::from_bin_values(&values, origin)
+    }
+
+    /// The table of BRDF values (1/sr, already including the channel scales) given in bin
+    /// order: index `ip + 180 (id + 90 ih)`, the order of the file. Non-finite values are an
+    /// error; negative values are stored as they are (invalid).
+    pub fn from_bin_values(values: &[[f64; 3]], origin: &str) -> Result<Self> {
+        if values.len() != TABLE_LEN {
+            return Err(Error::MerlFormat {
+                origin: origin.into(),
+                fault: format!("{} values, a MERL table has {TABLE_LEN}", values.len()),
             });
+        }
+        let mut raw = vec![0.0; 3 * TABLE_LEN];
+        for (i, v) in values.iter().enumerate() {
+            for c in 0..3 {
+                raw[i + c * TABLE_LEN] = v[c] / CHANNEL_SCALES[c];
+            }
+        }
         Self::from_raw(raw, origin)
     }
 
