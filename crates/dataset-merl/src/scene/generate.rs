@@ -239,8 +239,7 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
 
         let mut stats = stats.into_inner().unwrap();
         stats.foreground_pixels = geometry.views.iter().map(|v| v.len() as u64).sum();
-        let all = stats.lit_samples + stats.shadowed_samples + stats.back_facing_samples;
-        stats.saturated_fraction = stats.saturated_samples as f64 / all.max(1) as f64;
+        stats.update_saturated_fraction();
         let mut files = files.into_inner().unwrap();
         files.sort_by(|a, b| a.path.cmp(&b.path));
         let view_infos = views

@@ -98,6 +98,18 @@ pub struct SceneStats {
     pub saturated_fraction: f64,
 }
 
+impl SceneStats {
+    /// Sets `saturated_fraction` from the counts, rounded to 1e-12 so that it survives the
+    /// manifest's JSON round trip bit for bit: serde_json's default float parser is exact only
+    /// for decimals of at most 15 significant digits, and the manifest's checksum is taken over
+    /// the re-serialised values.
+    pub fn update_saturated_fraction(&mut self) {
+        let all = self.lit_samples + self.shadowed_samples + self.back_facing_samples;
+        let f = self.saturated_samples as f64 / all.max(1) as f64;
+        self.saturated_fraction = (f * 1e12).round() / 1e12;
+    }
+}
+
 /// The manifest of a scene directory.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -178,5 +190,26 @@ impl Manifest {
             }
             Ok(())
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn saturated_fraction_survives_the_json_round_trip() {
+        for (sat, lit) in [(298, 662_000), (1, 3), (7, 1_000_000_007), (0, 0)] {
+            let mut st =
+                SceneStats { saturated_samples: sat, lit_samples: lit, ..Default::default() };
+            st.update_saturated_fraction();
+            let back: SceneStats =
+                serde_json::from_str(&serde_json::to_string(&st).unwrap()).unwrap();
+            assert_eq!(
+                back.saturated_fraction.to_bits(),
+                st.saturated_fraction.to_bits(),
+                "{sat}/{lit}"
+            );
+        }
     }
 }
