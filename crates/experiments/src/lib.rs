@@ -5,7 +5,9 @@
 //! * [`loss`]: the sRGB-gamma MSE and the enhanced split's regularisers.
 //! * [`train`]: [`fit`], the training loop with checkpoints, resume and non-finite detection.
 //! * [`checkpoint`], [`run_dir`]: what a run directory holds, written atomically.
-//! * [`eval`]: test renders and metrics of a finished run.
+//! * [`eval`]: test renders, maps and every metric of a finished run.
+//! * [`export`]: a fitted model as a MERL-format table at one surface point.
+//! * [`report`]: result tables (Markdown, LaTeX) and figures (PNG) from evaluated runs.
 //!
 //! The binary `experiments` wraps these as `fit` and `eval` (`experiments --help`):
 //!
@@ -29,7 +31,9 @@ pub mod data;
 pub mod diagnose;
 mod error;
 pub mod eval;
+pub mod export;
 pub mod loss;
+pub mod report;
 pub mod run_dir;
 pub mod train;
 

@@ -1,9 +1,11 @@
 //! The `experiments` command line: `fit` trains a model on a scene into a run directory, `eval`
-//! renders the test images of a finished run and computes its metrics.
+//! renders the test images of a finished run and computes its metrics, `export-merl` writes the
+//! fitted material as a MERL binary.
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use experiments::config::RunConfig;
+use experiments::export::SurfacePoint;
 use experiments::run_dir::CONFIG_FILE;
 use experiments::{FitOptions, FitOutcome};
 use std::path::PathBuf;
@@ -42,6 +44,28 @@ enum Command {
     Eval {
         /// Run directory.
         run: PathBuf,
+        /// Scene directory (default: the one in the run's config).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Eigenpair cache directory (default: `<run>/../cache`).
+        #[arg(long)]
+        cache: Option<PathBuf>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Write a finished run's fitted material as a MERL binary (90 x 90 x 180 bins) at one
+    /// surface point, for any renderer that reads MERL files.
+    ExportMerl {
+        /// Run directory.
+        run: PathBuf,
+        /// Output file (conventionally `<name>.binary`).
+        #[arg(long)]
+        out: PathBuf,
+        /// Mesh vertex to evaluate at (default: the vertex whose encoding is closest to the
+        /// mesh average).
+        #[arg(long)]
+        vertex: Option<usize>,
         /// Scene directory (default: the one in the run's config).
         #[arg(long)]
         scene: Option<PathBuf>,
@@ -94,6 +118,26 @@ fn main() -> Result<()> {
             let metrics = experiments::eval::eval(&run, scene.as_deref(), cache.as_deref(), !quiet)
                 .with_context(|| format!("eval of {}", run.display()))?;
             println!("{}", serde_json::to_string_pretty(&metrics)?);
+        }
+        Command::ExportMerl { run, out, vertex, scene, cache, quiet } => {
+            let point = vertex.map_or(SurfacePoint::Representative, SurfacePoint::Vertex);
+            let e = experiments::export::export_merl(
+                &run,
+                &out,
+                point,
+                scene.as_deref(),
+                cache.as_deref(),
+                !quiet,
+            )
+            .with_context(|| format!("export-merl of {}", run.display()))?;
+            println!(
+                "wrote {} (vertex {} at {:?}; {} below-horizon bins set to 0) in {:.1} s",
+                out.display(),
+                e.vertex,
+                e.position,
+                e.below_horizon,
+                e.seconds
+            );
         }
     }
     Ok(())

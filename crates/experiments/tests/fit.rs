@@ -155,6 +155,28 @@ fn models_fit_the_scene_and_eval_scores_them() {
         assert_eq!(count("albedo"), if additive { 2 } else { 0 }, "{kind}: albedo maps");
         let first = std::fs::read_dir(run.join("flip")).unwrap().next().unwrap().unwrap();
         assert_eq!(image::open(first.path()).unwrap().width(), 64, "{kind}: FLIP map size");
+        if kind == "disney" {
+            // The fitted material as a MERL file: the real format, readable back, finite,
+            // and (a Lambertian scene, 300 steps) within a factor 2 of albedo / pi at normal
+            // incidence: catches a wrong unit or channel scale (a factor of about 1,500).
+            let out = run.join("fitted.binary");
+            let point = experiments::export::SurfacePoint::Representative;
+            let e = experiments::export::export_merl(&run, &out, point, None, None, false).unwrap();
+            let merl = dataset_merl::MerlBrdf::read(&out).unwrap();
+            assert_eq!(
+                std::fs::metadata(&out).unwrap().len() as usize,
+                dataset_merl::merl::FILE_BYTES
+            );
+            assert_eq!(merl.invalid_entries(), 0);
+            let f = merl.bin(0, 0, 0).unwrap();
+            let expected = [0.6, 0.3, 0.15].map(|a: f64| a / std::f64::consts::PI);
+            for c in 0..3 {
+                assert!(
+                    f[c] > 0.5 * expected[c] && f[c] < 2.0 * expected[c],
+                    "{e:?}: {f:?} vs {expected:?}"
+                );
+            }
+        }
     }
 }
 
