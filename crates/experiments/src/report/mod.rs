@@ -1,0 +1,45 @@
+//! Result tables and figures from evaluated runs: pure functions from in-memory
+//! [`RunRecord`]s to Markdown, LaTeX and PNG bytes (no file access; the caller finds the runs
+//! and writes the outputs).
+//!
+//! * [`record`]: [`RunRecord`] (model, options, data set, object, metrics) and its vocabulary.
+//! * [`average`]: each run's last evaluation, averages per object then over objects, paired
+//!   deltas.
+//! * [`table`], [`rank`]: the table model and its highlighting (best / second / third,
+//!   improvements); [`markdown`] and [`latex`] render it.
+//! * [`tables`]: Table 1, reciprocity RMSE, energy conservation, per-object tables.
+//! * [`deltas`]: the ablations (NOL, reciprocity options, angle parametrization, NeRFactor
+//!   changes) as differences to the baseline.
+//! * [`plot`], [`grid`], [`figures`]: line plots (error against training time) and image
+//!   grids (qualitative comparisons, FLIP maps, diffuse / specular / albedo splits), drawn on
+//!   a [`canvas`] with the embedded bitmap [`font`].
+//!
+//! Conventions: cells print `–` for a combination that was not run and `n/a` for a metric
+//! that could not be computed (its reason is listed under the table); every caption names the
+//! data and the profile.
+
+pub mod average;
+pub mod canvas;
+pub mod deltas;
+pub mod figures;
+pub mod font;
+pub mod grid;
+pub mod latex;
+pub mod markdown;
+pub mod plot;
+pub mod rank;
+pub mod record;
+pub mod table;
+pub mod tables;
+
+pub use deltas::{
+    Variant, nerfactor_deltas, nol_deltas, parametrization_deltas, reciprocity_deltas,
+};
+pub use figures::{ModelRender, QualitativeRow, qualitative_grid, runtime_plot};
+pub use grid::{GridCell, GridRow, ImageGrid, RgbImage, image_grid_png};
+pub use latex::{LATEX_PREAMBLE, to_latex};
+pub use markdown::to_markdown;
+pub use plot::{LinePlot, Series, line_plot_png};
+pub use record::{Dataset, Direction, MetricKind, RunOptions, RunRecord};
+pub use table::{Cell, Column, ColumnGroup, Marking, Row, Table};
+pub use tables::{energy_table, per_object_table, reciprocity_table, table1};
