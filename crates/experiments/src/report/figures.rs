@@ -27,7 +27,7 @@ pub fn runtime_plot(
     profile: &str,
 ) -> LinePlot {
     let mut plot = LinePlot::new(
-        format!("{} against training time - {}, profile {profile}", ascii(metric), dataset.label()),
+        format!("{} vs time - {}, profile {profile}", ascii(metric), dataset.label()),
         "training time (s)",
         y_label(metric),
     );

@@ -201,8 +201,9 @@ pub fn grid_geometry(grid: &ImageGrid) -> GridGeometry {
     let top = pad + title_h + header_h;
     let column_step = slot_width + pad;
     let row_step = slot_height + if has_captions { pad / 2 + gh } else { 0 } + pad;
+    let title_w = text_w(&grid.title) + 2 * pad;
     GridGeometry {
-        width: left + columns as i64 * column_step,
+        width: (left + columns as i64 * column_step).max(title_w),
         height: top + grid.rows.len() as i64 * row_step,
         left,
         top,

@@ -261,7 +261,10 @@ pub fn draw_line_plot(plot: &LinePlot) -> Result<(Canvas, Frame)> {
     }
 
     // Title, axis labels, legend.
-    canvas.text_centered(w / 2, pad, &plot.title, fs, BLACK);
+    // The title shrinks (down to scale 1) to fit the width.
+    let title_fs =
+        (1..=fs).rev().find(|&s| i64::from(text_width(&plot.title, s)) <= w - 2 * pad).unwrap_or(1);
+    canvas.text_centered(w / 2, pad, &plot.title, title_fs, BLACK);
     let x_label_y = frame.bottom + 8 + pad / 2 + gh + pad;
     canvas.text_centered((frame.left + frame.right) / 2, x_label_y, &plot.x_label, fs, BLACK);
     let y_label_w = i64::from(text_width(&plot.y_label, fs));
