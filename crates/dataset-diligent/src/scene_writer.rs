@@ -290,8 +290,7 @@ fn assemble(
 
     let mut stats = stats.into_inner().unwrap();
     stats.foreground_pixels = reports.iter().map(|r| r.both_pixels).sum();
-    let all = stats.lit_samples + stats.shadowed_samples + stats.back_facing_samples;
-    stats.saturated_fraction = stats.saturated_samples as f64 / all.max(1) as f64;
+    stats.update_saturated_fraction();
     let mut files = files.into_inner().unwrap();
     files.sort_by(|a, b| a.path.cmp(&b.path));
     let mut manifest = Manifest {
