@@ -7,6 +7,7 @@
 //! * [`checkpoint`], [`run_dir`]: what a run directory holds, written atomically.
 //! * [`eval`]: test renders, maps and every metric of a finished run.
 //! * [`export`]: a fitted model as a MERL-format table at one surface point.
+//! * [`sweep`]: profiles, content-addressed runs, parallel / cluster execution, `collect`.
 //! * [`report`]: result tables (Markdown, LaTeX) and figures (PNG) from evaluated runs.
 //!
 //! The binary `experiments` wraps these as `fit` and `eval` (`experiments --help`):
@@ -35,6 +36,7 @@ pub mod export;
 pub mod loss;
 pub mod report;
 pub mod run_dir;
+pub mod sweep;
 pub mod train;
 
 pub use config::{RunConfig, TrainConfig};

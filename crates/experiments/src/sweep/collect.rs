@@ -1,0 +1,369 @@
+//! `collect`: the tables and figures of any set of evaluated run directories.
+//!
+//! Each run directory (found recursively below the given paths) contributes a
+//! [`RunRecord`] from its `config.toml`, `metrics.json` and `run.json` (runs made outside a
+//! sweep, without `run.json`, count as Table 1 / ablation runs on the object named by their
+//! scene directory). Written, atomically, under `<out>/`:
+//!
+//! ```text
+//! tables/table1.{md,tex}           Table 1 (every data set present)
+//! tables/nol.{md,tex}              NOL deltas            tables/reciprocity.{md,tex}
+//! tables/reciprocity-deltas.*      swap / mapping deltas tables/angles.{md,tex}
+//! tables/nerfactor.{md,tex}        NeRFactor changes     tables/energy.{md,tex}
+//! tables/per-object-psnr.*         per object            tables/per-object-rmse.*
+//! tables/runtime.md                run time against error (steps, seconds, PSNR, RMSE∛)
+//! tables/all.md                    every table in one file
+//! figures/qualitative-<object>.png GT and every model's render with its PSNR, FLIP maps
+//! figures/split-<object>.png       additive models: render, diffuse, specular, albedo
+//! figures/runtime-psnr.png, runtime-rmse.png
+//! ```
+
+use super::plan::{self, Purpose};
+use crate::config::RunConfig;
+use crate::report::{
+    self, Dataset, MetricKind, ModelRender, QualitativeRow, RgbImage, RunOptions, RunRecord, Table,
+};
+use crate::run_dir::{CONFIG_FILE, METRICS_FILE, RunMetrics, write_atomic};
+use crate::{Error, Result};
+use metrics::aggregate::Score;
+use std::path::{Path, PathBuf};
+
+/// One collected run.
+#[derive(Clone, Debug)]
+pub struct CollectedRun {
+    /// Its directory.
+    pub dir: PathBuf,
+    /// Its configuration.
+    pub config: RunConfig,
+    /// Why it ran.
+    pub purposes: Vec<Purpose>,
+    /// The record of its final weights.
+    pub record: RunRecord,
+}
+
+/// Every run directory below `paths` (a directory holding `config.toml` and `metrics.json`).
+pub fn find_runs(paths: &[PathBuf]) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack: Vec<PathBuf> = paths.to_vec();
+    while let Some(p) = stack.pop() {
+        if p.join(CONFIG_FILE).is_file() && p.join(METRICS_FILE).is_file() {
+            out.push(p);
+            continue;
+        }
+        if let Ok(entries) = std::fs::read_dir(&p) {
+            for e in entries.flatten() {
+                if e.file_type().is_ok_and(|t| t.is_dir()) {
+                    stack.push(e.path());
+                }
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// The record of an evaluated run (`None` when it has no test metrics yet).
+pub fn read_run(dir: &Path) -> Result<Option<CollectedRun>> {
+    let config = RunConfig::read(&dir.join(CONFIG_FILE))?;
+    let m = RunMetrics::read(&dir.join(METRICS_FILE))?;
+    let Some(t) = m.test.as_ref() else { return Ok(None) };
+    let (object, dataset, purposes) = match plan::read_info(dir) {
+        Ok(i) => (i.object, Dataset::from_label(&i.dataset), i.purposes),
+        Err(_) => {
+            let object = config
+                .scene
+                .as_ref()
+                .and_then(|s| s.file_name())
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "unknown".into());
+            (object, Dataset::MerlNbrdf, vec![Purpose::Table, Purpose::Ablation])
+        }
+    };
+    let opt = |v: Option<f64>, why: &str| match v {
+        Some(x) => Score::Value(x),
+        None => Score::Unavailable(why.into()),
+    };
+    let mut r = RunRecord::new(config.model.kind, dataset, object)
+        .with_options(RunOptions::of(&config.model))
+        .with_value(MetricKind::Psnr, t.psnr)
+        .with_value(MetricKind::Dssim, t.dssim)
+        .with_value(MetricKind::Flip, t.flip)
+        .with(
+            MetricKind::Lpips,
+            opt(t.lpips, t.lpips_unavailable.as_deref().unwrap_or("not computed")),
+        )
+        .with_value(MetricKind::TrainingSeconds, m.wall_seconds);
+    if let Some(v) = t.rmse_cbrt {
+        r = r.with_value(MetricKind::CubeRootRmse, v);
+    }
+    if let Some(v) = t.reciprocity_rmse {
+        r = r.with_value(MetricKind::ReciprocityRmse, v);
+    }
+    if let Some(e) = &t.energy {
+        r = r.with_value(MetricKind::EnergyPercentAbove1, e.percent_above_one);
+        r = r.with(MetricKind::EnergyMedianAbove1, opt(e.median_above_one, "no pair above 1"));
+    }
+    Ok(Some(CollectedRun { dir: dir.to_path_buf(), config, purposes, record: r }))
+}
+
+/// What [`collect`] wrote.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CollectSummary {
+    /// Evaluated runs collected.
+    pub runs: usize,
+    /// Run directories without test metrics (not finished), left out.
+    pub unfinished: usize,
+    /// Files written.
+    pub files: Vec<PathBuf>,
+}
+
+fn write(out: &Path, rel: &str, bytes: &[u8], summary: &mut CollectSummary) -> Result<()> {
+    let path = out.join(rel);
+    write_atomic(&path, bytes)?;
+    summary.files.push(path);
+    Ok(())
+}
+
+/// Builds every table and figure of the runs below `paths` into `out`.
+pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSummary> {
+    let mut summary = CollectSummary::default();
+    let mut runs = Vec::new();
+    for dir in find_runs(paths) {
+        match read_run(&dir)? {
+            Some(r) => runs.push(r),
+            None => summary.unfinished += 1,
+        }
+    }
+    summary.runs = runs.len();
+    if runs.is_empty() {
+        return Err(Error::format(
+            paths.first().map(PathBuf::as_path).unwrap_or(Path::new(".")),
+            "no evaluated run found",
+        ));
+    }
+    let table_records: Vec<RunRecord> = runs
+        .iter()
+        .filter(|r| r.purposes.iter().any(|p| *p != Purpose::Runtime))
+        .map(|r| r.record.clone())
+        .collect();
+    let runtime_records: Vec<RunRecord> = runs
+        .iter()
+        .filter(|r| r.purposes.contains(&Purpose::Runtime))
+        .map(|r| r.record.clone().at_steps(r.config.train.iterations))
+        .collect();
+    let mut all_md = String::new();
+    if !table_records.is_empty() {
+        let rec = &table_records;
+        let mut tables: Vec<(String, Table)> = vec![
+            ("table1".into(), report::table1(rec, profile)),
+            ("nol".into(), report::nol_deltas(rec, profile)),
+            ("reciprocity".into(), report::reciprocity_table(rec, profile)),
+            ("reciprocity-deltas".into(), report::reciprocity_deltas(rec, profile)),
+            ("angles".into(), report::parametrization_deltas(rec, profile)),
+            ("nerfactor".into(), report::nerfactor_deltas(rec, profile)),
+            ("energy".into(), report::energy_table(rec, profile)),
+        ];
+        for (d, tag) in [
+            (Dataset::MerlNbrdf, ""),
+            (Dataset::DiligentMv, "-diligent-mv"),
+            (Dataset::Diligent, "-diligent"),
+        ] {
+            if rec.iter().any(|r| r.dataset == d) {
+                let psnr = report::per_object_table(rec, &d, MetricKind::Psnr, profile);
+                tables.push((format!("per-object-psnr{tag}"), psnr));
+                if d.has_brdf_ground_truth() {
+                    let rmse = report::per_object_table(rec, &d, MetricKind::CubeRootRmse, profile);
+                    tables.push((format!("per-object-rmse{tag}"), rmse));
+                }
+            }
+        }
+        for (name, t) in &tables {
+            let md = report::to_markdown(t);
+            write(out, &format!("tables/{name}.md"), md.as_bytes(), &mut summary)?;
+            write(
+                out,
+                &format!("tables/{name}.tex"),
+                report::to_latex(t).as_bytes(),
+                &mut summary,
+            )?;
+            all_md.push_str(&md);
+            all_md.push('\n');
+        }
+        figures(&runs, out, &mut summary)?;
+    }
+    if !runtime_records.is_empty() {
+        let md = runtime_markdown(&runtime_records, profile);
+        write(out, "tables/runtime.md", md.as_bytes(), &mut summary)?;
+        all_md.push_str(&md);
+        for (metric, name) in [(MetricKind::Psnr, "psnr"), (MetricKind::CubeRootRmse, "rmse")] {
+            let plot = report::runtime_plot(&runtime_records, &Dataset::MerlNbrdf, metric, profile);
+            if !plot.series.is_empty() {
+                let png = report::line_plot_png(&plot)?;
+                write(out, &format!("figures/runtime-{name}.png"), &png, &mut summary)?;
+            }
+        }
+    }
+    write(out, "tables/all.md", all_md.as_bytes(), &mut summary)?;
+    Ok(summary)
+}
+
+/// The run-time table: per model and budget, steps, training seconds, PSNR and RMSE∛ (x100).
+fn runtime_markdown(records: &[RunRecord], profile: &str) -> String {
+    let mut rows: Vec<&RunRecord> = records.iter().collect();
+    rows.sort_by_key(|r| (r.model as usize, r.steps));
+    let mut s = format!(
+        "**Run time against error: MERL-derived (NBRDF), profile {profile} (averaged over objects)**\n\n\
+         | model | steps | train time (s) | PSNR ↑ | RMSE∛ ×100 ↓ |\n| --- | ---: | ---: | ---: | ---: |\n"
+    );
+    let value = |r: &RunRecord, m: MetricKind| match r.metric(m) {
+        Some(Score::Value(v)) => Some(*v),
+        _ => None,
+    };
+    for r in rows {
+        let f = |v: Option<f64>, scale: f64, d: usize| {
+            v.map_or("n/a".into(), |x| format!("{:.*}", d, x * scale))
+        };
+        s.push_str(&format!(
+            "| {} | {} | {} | {} | {} |\n",
+            r.model.paper_name(),
+            r.steps.unwrap_or(0),
+            f(value(r, MetricKind::TrainingSeconds), 1.0, 1),
+            f(value(r, MetricKind::Psnr), 1.0, 2),
+            f(value(r, MetricKind::CubeRootRmse), 100.0, 2),
+        ));
+    }
+    s.push('\n');
+    s
+}
+
+fn load_exr(path: &Path) -> Result<metrics::Image> {
+    let (w, h, px) = dataset_merl::scene::images::read_exr_rgb(path)?;
+    Ok(metrics::Image::new(w, h, px.into_iter().flatten().collect())?)
+}
+
+fn load_png(path: &Path) -> Result<RgbImage> {
+    let img = image::open(path).map_err(|e| Error::format(path, e.to_string()))?.to_rgb8();
+    let (w, h) = img.dimensions();
+    let px: Vec<[u8; 3]> = img.pixels().map(|p| p.0).collect();
+    Ok(RgbImage::new(w, h, px)?)
+}
+
+/// The qualitative grid and the split figure of every object (first test image).
+fn figures(runs: &[CollectedRun], out: &Path, summary: &mut CollectSummary) -> Result<()> {
+    let mut objects: Vec<&str> = runs.iter().map(|r| r.record.object.as_str()).collect();
+    objects.sort();
+    objects.dedup();
+    for object in objects {
+        let mut mine: Vec<&CollectedRun> = runs
+            .iter()
+            .filter(|r| {
+                r.record.object == object
+                    && r.record.options == RunOptions::DEFAULT
+                    && r.purposes.contains(&Purpose::Table)
+            })
+            .collect();
+        mine.sort_by_key(|r| r.record.model as usize);
+        let Some(first) = mine.first() else { continue };
+        let Some(scene) = first.config.scene.clone() else { continue };
+        let Some(stem) = first_render(&first.dir) else { continue };
+        let Some((v, l)) = parse_stem(&stem) else { continue };
+        let gt_path =
+            scene.join(format!("images/{}.exr", dataset_merl::scene::generate::sample_stem(v, l)));
+        let Ok(gt) = load_exr(&gt_path) else { continue };
+        let flags = dataset_merl::scene::images::read_png_gray(
+            &scene.join(format!("flags/{}.png", dataset_merl::scene::generate::sample_stem(v, l))),
+        );
+        let mask: Option<Vec<bool>> =
+            flags.ok().map(|(_, _, f)| f.iter().map(|&b| b & 7 != 0).collect());
+        let mut renders = Vec::new();
+        let mut split_rows = Vec::new();
+        for r in &mine {
+            let Ok(img) = load_exr(&r.dir.join(format!("renders/{stem}.exr"))) else { continue };
+            let psnr = metrics::psnr_linear(&img, &gt, mask.as_deref())
+                .map(Score::Value)
+                .unwrap_or_else(|e| Score::Unavailable(e.to_string()));
+            let flip = load_png(&r.dir.join(format!("flip/{stem}.png"))).ok().map(|map| {
+                let mean = metrics::hdr_flip(&img, &gt, mask.as_deref())
+                    .map(Score::Value)
+                    .unwrap_or_else(|e| Score::Unavailable(e.to_string()));
+                (map, mean)
+            });
+            let name = r.record.model.paper_name().to_string();
+            renders.push(ModelRender {
+                model: name.clone(),
+                render: RgbImage::from_linear(&img),
+                psnr_db: psnr,
+                flip,
+            });
+            if r.record.model.is_additive() {
+                let mut cells = vec![("render".to_string(), RgbImage::from_linear(&img))];
+                for (label, file) in [
+                    ("diffuse", format!("renders/{stem}_diffuse.png")),
+                    ("specular", format!("renders/{stem}_specular.png")),
+                    ("albedo", format!("albedo/view{v:03}.png")),
+                ] {
+                    if let Ok(p) = load_png(&r.dir.join(file)) {
+                        cells.push((label.to_string(), p));
+                    }
+                }
+                split_rows.push((name, cells));
+            }
+        }
+        let row = QualitativeRow {
+            label: format!("view {v}, light {l}"),
+            reference: RgbImage::from_linear(&gt),
+            renders,
+        };
+        let grid = report::qualitative_grid(&format!("{object}: test view {v}, light {l}"), &[row]);
+        write(
+            out,
+            &format!("figures/qualitative-{object}.png"),
+            &report::image_grid_png(&grid)?,
+            summary,
+        )?;
+        if !split_rows.is_empty() {
+            let headers = ["render", "diffuse", "specular", "albedo"].map(String::from).to_vec();
+            let grid = report::ImageGrid::from_images(
+                format!("{object}: additive split, view {v}, light {l}"),
+                headers,
+                split_rows,
+            );
+            write(
+                out,
+                &format!("figures/split-{object}.png"),
+                &report::image_grid_png(&grid)?,
+                summary,
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// The stem (`view007_light003`) of the first EXR render of a run.
+fn first_render(run: &Path) -> Option<String> {
+    let mut names: Vec<String> = std::fs::read_dir(run.join("renders"))
+        .ok()?
+        .flatten()
+        .filter_map(|e| e.file_name().to_str().map(String::from))
+        .filter(|n| n.ends_with(".exr"))
+        .collect();
+    names.sort();
+    names.first().map(|n| n.trim_end_matches(".exr").to_string())
+}
+
+fn parse_stem(stem: &str) -> Option<(usize, usize)> {
+    let rest = stem.strip_prefix("view")?;
+    let (v, l) = rest.split_once("_light")?;
+    Some((v.parse().ok()?, l.parse().ok()?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stems_parse() {
+        assert_eq!(parse_stem("view007_light012"), Some((7, 12)));
+        assert_eq!(parse_stem("v07_l12"), None);
+    }
+}

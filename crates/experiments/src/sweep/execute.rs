@@ -1,0 +1,324 @@
+//! Running a sweep: scenes first (generated once, kept when complete), then the LBO tables of
+//! their meshes (so that parallel runs do not solve the same eigenproblem twice), then the
+//! runs, in this process or as `--jobs N` child processes, or written as one shell command per
+//! run for a cluster scheduler (`--emit-jobs`).
+//!
+//! A run is done when its `metrics.json` holds test metrics; [`run_one`] otherwise fits
+//! (resuming from the last checkpoint) and evaluates it. A killed sweep therefore resumes with
+//! nothing lost but the steps since the last checkpoint.
+
+use super::plan::{self, Purpose, RunInfo, RunSpec, SceneSpec};
+use super::profile::{SweepProfile, resolve_mesh};
+use crate::config::SpatialKind;
+use crate::run_dir::{METRICS_FILE, RunMetrics};
+use crate::{Error, FitOptions, FitOutcome, Result, fit};
+use dataset_merl::scene::{MaterialSpec, SceneConfig, SceneSettings};
+use dataset_merl::{SceneDataset, generate_scene};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+/// How runs are executed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Execution {
+    /// One after the other in this process, with progress bars.
+    InProcess,
+    /// `jobs` child processes at a time, each `<program> <args...> <run dir>`.
+    Children {
+        /// Concurrent children.
+        jobs: usize,
+        /// The program and leading arguments that run one run directory.
+        command: Vec<String>,
+    },
+    /// Write the commands to this file (one line per unfinished run) and run nothing.
+    Emit {
+        /// The job file.
+        file: PathBuf,
+        /// The program and leading arguments that run one run directory.
+        command: Vec<String>,
+    },
+}
+
+/// What a sweep did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SweepSummary {
+    /// Scenes generated now / found complete.
+    pub scenes_generated: usize,
+    /// Scenes that were complete already.
+    pub scenes_kept: usize,
+    /// Run directories of the sweep, in plan order.
+    pub runs: Vec<PathBuf>,
+    /// Runs finished before this sweep started.
+    pub skipped: usize,
+    /// Runs completed now.
+    pub completed: usize,
+    /// Runs that failed: (directory, message).
+    pub failed: Vec<(PathBuf, String)>,
+    /// Commands written (`Emit`).
+    pub emitted: usize,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+}
+
+/// Whether a run directory holds an evaluated run.
+pub fn is_done(run: &Path) -> bool {
+    RunMetrics::read(&run.join(METRICS_FILE)).is_ok_and(|m| m.test.is_some())
+}
+
+/// Fits (resuming) and evaluates one prepared run directory.
+pub fn run_one(run: &Path, progress: bool) -> Result<()> {
+    if is_done(run) {
+        return Ok(());
+    }
+    let config = crate::RunConfig::read(&run.join(crate::run_dir::CONFIG_FILE))?;
+    let cache = run.parent().and_then(Path::parent).map(|o| o.join("cache"));
+    let options = FitOptions { progress, cache_dir: cache.clone(), ..Default::default() };
+    match fit(&config, run, options)? {
+        FitOutcome::Stopped(step) => {
+            return Err(Error::format(run, format!("training stopped at step {step}")));
+        }
+        FitOutcome::Finished { .. } | FitOutcome::AlreadyFinished(_) => {}
+    }
+    crate::eval::eval(run, None, cache.as_deref(), progress)?;
+    Ok(())
+}
+
+/// Generates the profile's scenes under `scenes_dir` (complete ones are kept).
+pub fn prepare_scenes(
+    profile: &SweepProfile,
+    scenes: &[SceneSpec],
+    scenes_dir: &Path,
+    data_root: &Path,
+    summary: &mut SweepSummary,
+) -> Result<Vec<PathBuf>> {
+    let d = &profile.data;
+    let defaults = SceneSettings::default();
+    let settings = SceneSettings {
+        width: d.size,
+        height: d.size,
+        views: d.views,
+        train_views: d.views / 2,
+        lights_per_view: d.lights,
+        train_lights: (d.lights * defaults.train_lights / defaults.lights_per_view.max(1)).max(1),
+        ..defaults
+    };
+    let mut dirs = Vec::new();
+    for (i, s) in scenes.iter().enumerate() {
+        let config = SceneConfig {
+            mesh: resolve_mesh(&s.mesh, data_root)?,
+            material: MaterialSpec::Merl { name: s.material.clone() },
+            seed: d.seed,
+            settings: settings.clone(),
+            merl_dir: None,
+        };
+        let out = scenes_dir.join(&s.name);
+        eprintln!("scene {}/{}: {}", i + 1, scenes.len(), s.name);
+        let r = generate_scene(&config, &out, true)?;
+        if r.skipped {
+            summary.scenes_kept += 1;
+        } else {
+            summary.scenes_generated += 1;
+        }
+        dirs.push(out);
+    }
+    Ok(dirs)
+}
+
+/// Creates (or finds) the directory of every planned run: `config.toml` with the scene path,
+/// and `run.json`.
+pub fn prepare_runs(
+    specs: &[RunSpec],
+    scenes: &[SceneSpec],
+    scene_dirs: &[PathBuf],
+    runs_dir: &Path,
+) -> Result<Vec<PathBuf>> {
+    let mut checksums = Vec::new();
+    for dir in scene_dirs {
+        let path = dir.join(dataset_merl::scene::manifest::MANIFEST_FILE);
+        checksums.push(dataset_merl::scene::Manifest::read(&path)?.checksum);
+    }
+    let mut dirs = Vec::new();
+    for spec in specs {
+        let id = plan::run_id(&spec.config, &checksums[spec.scene])?;
+        let object = &scenes[spec.scene].name;
+        let dir = runs_dir.join(plan::run_dir_name(object, &spec.config, &id));
+        let mut purposes: Vec<Purpose> =
+            plan::read_info(&dir).map(|i| i.purposes).unwrap_or_default();
+        for p in &spec.purposes {
+            if !purposes.contains(p) {
+                purposes.push(*p);
+            }
+        }
+        let info = RunInfo {
+            id,
+            object: object.clone(),
+            dataset: "MERL-derived (NBRDF)".into(),
+            purposes,
+            code_version: plan::CODE_VERSION.into(),
+        };
+        let mut config = spec.config.clone();
+        config.scene = Some(
+            std::path::absolute(&scene_dirs[spec.scene])
+                .map_err(|e| Error::io(&scene_dirs[spec.scene], e))?,
+        );
+        let config_path = dir.join(crate::run_dir::CONFIG_FILE);
+        if !config_path.is_file() {
+            crate::run_dir::write_atomic(&config_path, config.to_toml()?.as_bytes())?;
+        }
+        plan::write_info(&dir, &info)?;
+        dirs.push(dir);
+    }
+    Ok(dirs)
+}
+
+/// Computes the LBO tables of every scene's mesh once (cached under `cache`).
+pub fn prepare_features(specs: &[RunSpec], scene_dirs: &[PathBuf], cache: &Path) -> Result<()> {
+    let mut seen = Vec::new();
+    for spec in specs {
+        if spec.config.features.spatial != SpatialKind::Lbo {
+            continue;
+        }
+        let key = (spec.scene, format!("{:?}", spec.config.features.lbo));
+        if seen.contains(&key) {
+            continue;
+        }
+        seen.push(key);
+        let scene = SceneDataset::open(&scene_dirs[spec.scene])?;
+        crate::data::lbo_table(&scene, &spec.config.features, cache)?;
+    }
+    Ok(())
+}
+
+/// Executes the unfinished runs among `dirs`.
+pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) -> Result<()> {
+    let todo: Vec<&PathBuf> = dirs.iter().filter(|d| !is_done(d)).collect();
+    summary.skipped = dirs.len() - todo.len();
+    let bar = ProgressBar::new(todo.len() as u64);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "runs {bar:40} {pos}/{len} [{elapsed_precise}, eta {eta}] {msg}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    match how {
+        Execution::InProcess => {
+            for d in &todo {
+                bar.set_message(short(d));
+                match bar.suspend(|| run_one(d, true)) {
+                    Ok(()) => summary.completed += 1,
+                    Err(e) => summary.failed.push(((*d).clone(), e.to_string())),
+                }
+                bar.inc(1);
+            }
+        }
+        Execution::Children { jobs, command } => {
+            let (program, args) =
+                command.split_first().ok_or_else(|| Error::config("jobs", "no command"))?;
+            let mut queue = todo.iter();
+            let mut running: Vec<(PathBuf, std::process::Child)> = Vec::new();
+            loop {
+                while running.len() < (*jobs).max(1) {
+                    let Some(d) = queue.next() else { break };
+                    let log = d.join("sweep.log");
+                    std::fs::create_dir_all(d).map_err(|e| Error::io(d, e))?;
+                    let file = std::fs::File::create(&log).map_err(|e| Error::io(&log, e))?;
+                    let err = file.try_clone().map_err(|e| Error::io(&log, e))?;
+                    let child = Command::new(program)
+                        .args(args)
+                        .arg(d.as_path())
+                        .stdout(file)
+                        .stderr(err)
+                        .spawn()
+                        .map_err(|e| Error::io(Path::new(program), e))?;
+                    running.push(((*d).clone(), child));
+                }
+                if running.is_empty() {
+                    break;
+                }
+                std::thread::sleep(std::time::Duration::from_millis(200));
+                let mut i = 0;
+                while i < running.len() {
+                    if let Some(status) =
+                        running[i].1.try_wait().map_err(|e| Error::io(&running[i].0, e))?
+                    {
+                        let (d, _) = running.swap_remove(i);
+                        if status.success() && is_done(&d) {
+                            summary.completed += 1;
+                        } else {
+                            summary.failed.push((
+                                d.clone(),
+                                format!("{status}; see {}", d.join("sweep.log").display()),
+                            ));
+                        }
+                        bar.inc(1);
+                    } else {
+                        i += 1;
+                    }
+                }
+                bar.set_message(format!("{} running", running.len()));
+            }
+        }
+        Execution::Emit { file, command } => {
+            let mut text = String::new();
+            for d in &todo {
+                let abs = std::path::absolute(d).map_err(|e| Error::io(d, e))?;
+                let mut parts: Vec<String> = command.iter().map(|c| shell_quote(c)).collect();
+                parts.push(shell_quote(&abs.display().to_string()));
+                text.push_str(&parts.join(" "));
+                text.push('\n');
+            }
+            crate::run_dir::write_atomic(file, text.as_bytes())?;
+            summary.emitted = todo.len();
+        }
+    }
+    bar.finish_and_clear();
+    Ok(())
+}
+
+fn short(d: &Path) -> String {
+    d.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
+}
+
+/// Quotes a word for POSIX shells when needed.
+pub fn shell_quote(s: &str) -> String {
+    if !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || "-_./=:+@%".contains(c)) {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', "'\\''"))
+    }
+}
+
+/// Plans, prepares and executes a whole sweep into `out`.
+pub fn sweep(
+    profile: &SweepProfile,
+    out: &Path,
+    data_root: &Path,
+    how: &Execution,
+) -> Result<SweepSummary> {
+    let start = Instant::now();
+    let mut summary = SweepSummary::default();
+    let (scenes_dir, runs_dir, cache) = plan::layout(out);
+    let scenes = plan::scenes(profile);
+    let specs = plan::runs(profile)?;
+    let scene_dirs = prepare_scenes(profile, &scenes, &scenes_dir, data_root, &mut summary)?;
+    eprintln!("features: LBO tables of {} scene(s)", scene_dirs.len());
+    prepare_features(&specs, &scene_dirs, &cache)?;
+    summary.runs = prepare_runs(&specs, &scenes, &scene_dirs, &runs_dir)?;
+    execute(&summary.runs.clone(), how, &mut summary)?;
+    summary.seconds = start.elapsed().as_secs_f64();
+    Ok(summary)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shell_words_are_quoted() {
+        assert_eq!(shell_quote("/a/b-c_d.e"), "/a/b-c_d.e");
+        assert_eq!(shell_quote("a b"), "'a b'");
+        assert_eq!(shell_quote("it's"), "'it'\\''s'");
+        assert_eq!(shell_quote(""), "''");
+    }
+}

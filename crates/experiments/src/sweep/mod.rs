@@ -1,0 +1,26 @@
+//! Sweeps: the whole reproduction (`cargo xtask reproduce-tables`) and `collect`.
+//!
+//! * [`profile`]: the sweep profiles (`smoke`, `quick`, `runtime`, `full`, or a TOML file).
+//! * [`plan`]: scenes and runs of a profile, content-addressed run directories.
+//! * [`execute`]: scene generation, shared LBO tables, runs in-process, as child processes
+//!   (`--jobs`) or as a job file for a cluster (`--emit-jobs`).
+//! * [`collect`]: tables (Markdown + LaTeX) and figures (PNG) from any set of run directories.
+//!
+//! Layout of a sweep's output directory:
+//!
+//! ```text
+//! <out>/scenes/<mesh>__<material>/   generated scenes (kept when complete)
+//! <out>/cache/                       LBO eigenpairs and feature tables
+//! <out>/runs/<object>__<model>__<options>__<steps>__<id>/   one run (config, weights, metrics,
+//!                                    renders, FLIP maps, run.json)
+//! <out>/tables/, <out>/figures/      the results (see [`collect`])
+//! ```
+
+pub mod collect;
+pub mod execute;
+pub mod plan;
+pub mod profile;
+
+pub use collect::{CollectSummary, collect};
+pub use execute::{Execution, SweepSummary, run_one, sweep};
+pub use profile::{DEFAULT_PROFILE, SweepProfile};

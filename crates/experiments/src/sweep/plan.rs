@@ -1,0 +1,273 @@
+//! Expanding a profile into scenes and runs, each run content-addressed.
+//!
+//! A run's id is the xxh3-128 of its resolved configuration (without the scene path), the
+//! checksum of its scene's manifest (which covers the scene's configuration and every data
+//! file) and [`CODE_VERSION`]. Its directory is `runs/<object>__<model>__<options>__<id16>`: a
+//! finished run with the same id is reused, a half-finished one resumes from its checkpoint,
+//! and two profiles that share a run (the quick profile and the run-time curve) share its
+//! directory.
+
+use super::profile::{Ablation, SweepProfile, mesh_name};
+use crate::config::RunConfig;
+use crate::report::RunOptions;
+use crate::{Error, Result};
+use brdf_neural::{AngleParametrization, ModelKind, Reciprocity};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The version of the code that results depend on: bump it with any change that alters a
+/// result (training, models, data generation or metrics), so that content-addressed runs of
+/// the old code are not reused.
+pub const CODE_VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), "+results-1");
+
+/// Why a run is in the sweep.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Purpose {
+    /// A Table 1 row.
+    Table,
+    /// An ablation (NOL, reciprocity, angles, NeRFactor changes).
+    Ablation,
+    /// A point of the run-time curve (`iterations` = the budget).
+    Runtime,
+}
+
+/// One scene of the sweep.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneSpec {
+    /// `<mesh>__<material>`.
+    pub name: String,
+    /// Mesh source as written in the profile.
+    pub mesh: String,
+    /// Catalogue material.
+    pub material: String,
+}
+
+/// One run of the sweep.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunSpec {
+    /// Index into the scene list.
+    pub scene: usize,
+    /// Why it runs.
+    pub purposes: Vec<Purpose>,
+    /// Its configuration (the scene path is filled in when the scene exists).
+    pub config: RunConfig,
+}
+
+/// `run.json`: what a run directory is, for `collect`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunInfo {
+    /// Content address.
+    pub id: String,
+    /// The object (scene name).
+    pub object: String,
+    /// The data set label (`MERL-derived (NBRDF)`, `DiLiGenT`, ...).
+    pub dataset: String,
+    /// Why it ran (union over the profiles that planned it).
+    pub purposes: Vec<Purpose>,
+    /// [`CODE_VERSION`] of the code that planned it.
+    pub code_version: String,
+}
+
+/// The scenes of a profile, in order.
+pub fn scenes(profile: &SweepProfile) -> Vec<SceneSpec> {
+    profile
+        .scenes()
+        .into_iter()
+        .map(|(mesh, material)| SceneSpec {
+            name: format!("{}__{material}", mesh_name(&mesh)),
+            mesh,
+            material,
+        })
+        .collect()
+}
+
+/// The purely neural models (the NOL, reciprocity and angle ablations apply to them).
+pub fn purely_neural() -> [ModelKind; 5] {
+    [
+        ModelKind::SingleMlp,
+        ModelKind::AdditiveSeparate,
+        ModelKind::AdditiveShared,
+        ModelKind::AdditiveSeparateEnhanced,
+        ModelKind::AdditiveSharedEnhanced,
+    ]
+}
+
+fn with_options(
+    base: &RunConfig,
+    kind: ModelKind,
+    o: RunOptions,
+    iterations: Option<u64>,
+) -> Result<RunConfig> {
+    let mut c = base.clone();
+    let model = &mut c.model;
+    model.kind = kind;
+    model.angles.reciprocity = o.reciprocity;
+    model.angles.parametrization = o.parametrization;
+    model.nol = o.nol;
+    model.albedo_clamp = o.albedo_clamp;
+    model.scalar_specular = o.scalar_specular;
+    if let Some(n) = iterations {
+        c.train.iterations = n;
+        c.train.checkpoint_every = c.train.checkpoint_every.min(n);
+        c.train.warmup_steps = c.train.warmup_steps.min(n / 4);
+    }
+    c.model.spatial_dim = c.spatial_dim();
+    c.validate()?;
+    Ok(c)
+}
+
+/// Every run of `profile`, deduplicated (a run planned twice keeps one entry with both
+/// purposes).
+pub fn runs(profile: &SweepProfile) -> Result<Vec<RunSpec>> {
+    let base = RunConfig::from_toml(&profile.run, Path::new(&format!("{} [run]", profile.origin)))?;
+    let n_scenes = profile.scene_count();
+    let mut out: Vec<RunSpec> = Vec::new();
+    let mut push = |scene: usize, purpose: Purpose, config: RunConfig| {
+        if let Some(r) = out.iter_mut().find(|r| r.scene == scene && r.config == config) {
+            if !r.purposes.contains(&purpose) {
+                r.purposes.push(purpose);
+            }
+        } else {
+            out.push(RunSpec { scene, purposes: vec![purpose], config });
+        }
+    };
+    let d = RunOptions::DEFAULT;
+    for scene in 0..n_scenes {
+        for kind in profile.models()? {
+            push(scene, Purpose::Table, with_options(&base, kind, d, None)?);
+        }
+        for ablation in profile.ablations()? {
+            let variants: Vec<(ModelKind, RunOptions)> = match ablation {
+                Ablation::Nol => purely_neural()
+                    .into_iter()
+                    .map(|k| (k, RunOptions { nol: true, ..d }))
+                    .collect(),
+                Ablation::Reciprocity => purely_neural()
+                    .into_iter()
+                    .flat_map(|k| {
+                        [Reciprocity::RandomSwap, Reciprocity::Mapping]
+                            .map(|r| (k, RunOptions { reciprocity: r, ..d }))
+                    })
+                    .collect(),
+                Ablation::Angles => purely_neural()
+                    .into_iter()
+                    .map(|k| {
+                        (k, RunOptions { parametrization: AngleParametrization::ViewLight, ..d })
+                    })
+                    .collect(),
+                Ablation::Nerfactor => purely_neural()[1..]
+                    .iter()
+                    .flat_map(|&k| {
+                        [
+                            RunOptions { albedo_clamp: true, ..d },
+                            RunOptions { scalar_specular: true, ..d },
+                        ]
+                        .map(|o| (k, o))
+                    })
+                    .collect(),
+            };
+            for (kind, o) in variants {
+                // The ablation's baseline is the Table 1 run of the same model.
+                push(scene, Purpose::Table, with_options(&base, kind, d, None)?);
+                push(scene, Purpose::Ablation, with_options(&base, kind, o, None)?);
+            }
+        }
+    }
+    if !profile.sweep.runtime_budgets.is_empty() {
+        let kinds = if profile.sweep.models.is_empty() {
+            ModelKind::ALL.to_vec()
+        } else {
+            profile.models()?
+        };
+        for kind in kinds {
+            for &b in &profile.sweep.runtime_budgets {
+                push(
+                    profile.sweep.runtime_scene,
+                    Purpose::Runtime,
+                    with_options(&base, kind, d, Some(b))?,
+                );
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The content address of a run on a scene whose manifest checksum is `scene_checksum`.
+pub fn run_id(config: &RunConfig, scene_checksum: &str) -> Result<String> {
+    let mut c = config.clone();
+    c.scene = None;
+    c.features.cache_dir = None;
+    let text = format!("{}\n{scene_checksum}\n{CODE_VERSION}", c.to_toml()?);
+    Ok(format!("{:032x}", xxhash_rust::xxh3::xxh3_128(text.as_bytes())))
+}
+
+/// The directory name of a run: object, model, options and steps, then the first 16 digits
+/// of its id.
+pub fn run_dir_name(object: &str, config: &RunConfig, id: &str) -> String {
+    let options = RunOptions::of(&config.model).label().replace([',', ' '], "");
+    let steps = config.train.iterations;
+    let kind = config.model.kind.config_name();
+    format!("{object}__{kind}__{options}__{steps}__{}", &id[..16.min(id.len())])
+}
+
+/// Reads `run.json`.
+pub fn read_info(run: &Path) -> Result<RunInfo> {
+    let path = run.join(RUN_INFO_FILE);
+    let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+    serde_json::from_str(&text).map_err(|e| Error::format(&path, e.to_string()))
+}
+
+/// Writes `run.json` atomically.
+pub fn write_info(run: &Path, info: &RunInfo) -> Result<()> {
+    let path = run.join(RUN_INFO_FILE);
+    let text =
+        serde_json::to_string_pretty(info).map_err(|e| Error::format(&path, e.to_string()))?;
+    crate::run_dir::write_atomic(&path, text.as_bytes())
+}
+
+/// The file naming a sweep's run directory.
+pub const RUN_INFO_FILE: &str = "run.json";
+
+/// Where the sweep keeps scenes, runs, caches and results under `out`.
+pub fn layout(out: &Path) -> (PathBuf, PathBuf, PathBuf) {
+    (out.join("scenes"), out.join("runs"), out.join("cache"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plans_have_the_expected_runs() {
+        let quick = SweepProfile::load("quick").unwrap();
+        let r = runs(&quick).unwrap();
+        assert_eq!(r.len(), 27, "9 models x 3 scenes");
+        let smoke = SweepProfile::load("smoke").unwrap();
+        let r = runs(&smoke).unwrap();
+        // Per scene: 9 Table 1 runs, 5 NOL, 10 reciprocity, 5 angle, 8 NeRFactor ablations;
+        // the run-time curve adds 9 x 2 budgets on scene 0.
+        assert_eq!(r.len(), 2 * (9 + 5 + 10 + 5 + 8) + 18);
+        let runtime = SweepProfile::load("runtime").unwrap();
+        let rt = runs(&runtime).unwrap();
+        assert_eq!(rt.len(), 45);
+        // The 400-step curve point equals the quick profile's Table 1 run on that scene.
+        let q0 = &runs(&quick).unwrap()[0];
+        assert!(rt.iter().any(|r| r.config == q0.config), "shared by content address");
+    }
+
+    #[test]
+    fn ids_depend_on_config_and_data_only() {
+        let smoke = SweepProfile::load("smoke").unwrap();
+        let r = runs(&smoke).unwrap();
+        let a = run_id(&r[0].config, "abc").unwrap();
+        let mut moved = r[0].config.clone();
+        moved.scene = Some("/somewhere/else".into());
+        assert_eq!(run_id(&moved, "abc").unwrap(), a);
+        assert_ne!(run_id(&r[0].config, "abd").unwrap(), a);
+        assert_ne!(run_id(&r[1].config, "abc").unwrap(), a);
+        let name = run_dir_name("spot__blue-acrylic", &r[0].config, &a);
+        assert!(name.starts_with("spot__blue-acrylic__rp__default__30__"), "{name}");
+    }
+}
