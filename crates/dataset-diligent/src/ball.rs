@@ -56,7 +56,7 @@ pub fn fit_circle(mask: &[bool], width: usize) -> Option<CircleFit> {
     let s = a.inverse() * b;
     let (cx, cy) = (-0.5 * s.x, -0.5 * s.y);
     let r2 = cx * cx + cy * cy - s.z;
-    if !(r2 > 0.0) {
+    if r2.is_nan() || r2 <= 0.0 {
         return None;
     }
     let radius = r2.sqrt();

@@ -231,3 +231,31 @@ impl Capture {
         [0, 1, 2].map(|c| (raw[c] as f64 / 65535.0 / e[c]) as f32)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_parse_with_spaces_or_commas_and_name_the_bad_line() {
+        let dir =
+            std::env::temp_dir().join(format!("dataset-diligent-rows-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("rows.txt");
+        std::fs::write(&p, "1 2 3\n\n4,5,6\n").unwrap();
+        assert_eq!(read_rows(&p).unwrap(), [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]);
+        std::fs::write(&p, "1 2 3\n4 5\n").unwrap();
+        let e = read_rows(&p).unwrap_err().to_string();
+        assert!(e.contains("rows.txt") && e.contains("line 2"), "{e}");
+        std::fs::write(&p, "1 2 x\n").unwrap();
+        assert!(read_rows(&p).unwrap_err().to_string().contains("line 1"));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn diligent_axes_flip_y_and_z() {
+        // A light in front of the object, above the camera, is up (-y) and towards the camera
+        // (-z) in OpenCV's frame.
+        assert_eq!(diligent_to_opencv([0.1, 0.5, 0.8]), [0.1, -0.5, -0.8]);
+    }
+}

@@ -375,9 +375,9 @@ pub fn decimate(mesh: &TriMesh, options: &DecimateOptions) -> (TriMesh, Decimate
     // Compact.
     let mut remap = vec![u32::MAX; n];
     let mut positions = Vec::with_capacity(alive);
-    for v in 0..n {
+    for (v, slot) in remap.iter_mut().enumerate() {
         if !st.vtris[v].is_empty() {
-            remap[v] = positions.len() as u32;
+            *slot = positions.len() as u32;
             positions.push(st.pos[v].as_vec3());
         }
     }

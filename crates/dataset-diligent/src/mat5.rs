@@ -224,7 +224,7 @@ impl Reader<'_> {
             MI_DOUBLE | MI_INT64 | MI_UINT64 => 8,
             t => return Err(self.fault(format!("numeric data of unsupported type {t}"))),
         };
-        if d.len() % size != 0 {
+        if !d.len().is_multiple_of(size) {
             return Err(self.fault(format!("{} bytes of type {ty} is not whole values", d.len())));
         }
         Ok(match ty {
@@ -492,7 +492,7 @@ mod tests {
             m.extend_from_slice(&w.to_be_bytes());
         }
         for w in [MI_INT32, 8, 1, 3] {
-            m.extend_from_slice(&(w as u32).to_be_bytes());
+            m.extend_from_slice(&w.to_be_bytes());
         }
         m.extend_from_slice(&((2u32 << 16) | MI_INT8).to_be_bytes());
         m.extend_from_slice(b"Tc\0\0");

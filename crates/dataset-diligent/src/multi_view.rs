@@ -121,7 +121,7 @@ fn camera(mat: &MatFile, view: usize) -> Result<(DMat3, DVec3)> {
     let r = DMat3::from_cols_array(&[r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]]);
     let t = DVec3::new(t[0], t[1], t[2]);
     let orth = (r * r.transpose() - DMat3::IDENTITY).to_cols_array();
-    if orth.iter().any(|e| !(e.abs() < 1e-3))
+    if orth.iter().any(|e| e.is_nan() || e.abs() >= 1e-3)
         || (r.determinant() - 1.0).abs() > 1e-3
         || !t.is_finite()
     {

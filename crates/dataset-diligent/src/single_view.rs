@@ -28,7 +28,8 @@ use std::time::Instant;
 /// `K.txt` shipped with DiLiGenT's pot2 normal map in the Bilateral Normal Integration
 /// repository (xucao-42/bilateral_normal_integration, data/Fig7_diligent/pot2/K.txt), which
 /// takes it from the benchmark's calibration.
-pub const DILIGENT_INTRINSICS: [f64; 4] = [3772.077471010730, 3759.005431071330, 305.875, 255.125];
+pub const DILIGENT_INTRINSICS: [f64; 4] =
+    [3_772.077_471_010_73, 3_759.005_431_071_33, 305.875, 255.125];
 
 /// Options of [`import_single_view`].
 ///
