@@ -245,7 +245,7 @@ fn load_png(path: &Path) -> Result<RgbImage> {
     let img = image::open(path).map_err(|e| Error::format(path, e.to_string()))?.to_rgb8();
     let (w, h) = img.dimensions();
     let px: Vec<[u8; 3]> = img.pixels().map(|p| p.0).collect();
-    Ok(RgbImage::new(w, h, px)?)
+    RgbImage::new(w, h, px)
 }
 
 /// The qualitative grid and the split figure of every object (first test image).

@@ -134,30 +134,37 @@ pub fn runs(profile: &SweepProfile) -> Result<Vec<RunSpec>> {
         }
     };
     let d = RunOptions::DEFAULT;
+    let models = profile.models()?;
+    // The ablations apply to the profile's purely neural models (NeRFactor's to the additive
+    // ones among them).
+    let neural: Vec<ModelKind> =
+        purely_neural().into_iter().filter(|k| models.contains(k)).collect();
+    let additive: Vec<ModelKind> = neural.iter().copied().filter(|k| k.is_additive()).collect();
     for scene in 0..n_scenes {
-        for kind in profile.models()? {
+        for &kind in &models {
             push(scene, Purpose::Table, with_options(&base, kind, d, None)?);
         }
         for ablation in profile.ablations()? {
             let variants: Vec<(ModelKind, RunOptions)> = match ablation {
-                Ablation::Nol => purely_neural()
-                    .into_iter()
-                    .map(|k| (k, RunOptions { nol: true, ..d }))
-                    .collect(),
-                Ablation::Reciprocity => purely_neural()
-                    .into_iter()
+                Ablation::Nol => {
+                    neural.iter().map(|&k| (k, RunOptions { nol: true, ..d })).collect()
+                }
+                Ablation::Reciprocity => neural
+                    .iter()
+                    .copied()
                     .flat_map(|k| {
                         [Reciprocity::RandomSwap, Reciprocity::Mapping]
                             .map(|r| (k, RunOptions { reciprocity: r, ..d }))
                     })
                     .collect(),
-                Ablation::Angles => purely_neural()
-                    .into_iter()
+                Ablation::Angles => neural
+                    .iter()
+                    .copied()
                     .map(|k| {
                         (k, RunOptions { parametrization: AngleParametrization::ViewLight, ..d })
                     })
                     .collect(),
-                Ablation::Nerfactor => purely_neural()[1..]
+                Ablation::Nerfactor => additive
                     .iter()
                     .flat_map(|&k| {
                         [
