@@ -5,6 +5,7 @@
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use experiments::config::RunConfig;
+use experiments::eval::EnergyEstimator;
 use experiments::export::SurfacePoint;
 use experiments::run_dir::CONFIG_FILE;
 use experiments::{FitOptions, FitOutcome};
@@ -47,6 +48,24 @@ enum Command {
         /// Scene directory (default: the one in the run's config).
         #[arg(long)]
         scene: Option<PathBuf>,
+        /// Eigenpair cache directory (default: `<run>/../cache`).
+        #[arg(long)]
+        cache: Option<PathBuf>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Energy conservation of a finished run's model with a chosen estimator (the paper's
+    /// Monte Carlo or the fast importance-sampled QMC), printed as JSON; the run is unchanged.
+    Energy {
+        /// Run directory.
+        run: PathBuf,
+        /// `fast`, `paper` (20,000 cosine samples a pair) or `off`.
+        #[arg(long, default_value = "fast")]
+        estimator: String,
+        /// (x, l) pairs (default: the run's `[eval]` setting).
+        #[arg(long)]
+        pairs: Option<usize>,
         /// Eigenpair cache directory (default: `<run>/../cache`).
         #[arg(long)]
         cache: Option<PathBuf>,
@@ -118,6 +137,18 @@ fn main() -> Result<()> {
             let metrics = experiments::eval::eval(&run, scene.as_deref(), cache.as_deref(), !quiet)
                 .with_context(|| format!("eval of {}", run.display()))?;
             println!("{}", serde_json::to_string_pretty(&metrics)?);
+        }
+        Command::Energy { run, estimator, pairs, cache, quiet } => {
+            let estimator = match estimator.as_str() {
+                "fast" => EnergyEstimator::Fast,
+                "paper" => EnergyEstimator::Paper,
+                "off" => EnergyEstimator::Off,
+                other => bail!("--estimator {other:?}: expected fast, paper or off"),
+            };
+            let e =
+                experiments::eval::energy_of_run(&run, estimator, pairs, cache.as_deref(), !quiet)
+                    .with_context(|| format!("energy of {}", run.display()))?;
+            println!("{}", serde_json::to_string_pretty(&e)?);
         }
         Command::ExportMerl { run, out, vertex, scene, cache, quiet } => {
             let point = vertex.map_or(SurfacePoint::Representative, SurfacePoint::Vertex);

@@ -66,6 +66,38 @@ pub struct TestMetrics {
     pub seconds: f64,
 }
 
+/// Only the energy analysis of a finished run, with `estimator` and `pairs` overriding the
+/// run's `[eval]` settings (for comparing the two estimators on one model).
+pub fn energy_of_run(
+    run: &Path,
+    estimator: EnergyEstimator,
+    pairs: Option<usize>,
+    cache: Option<&Path>,
+    progress: bool,
+) -> Result<Option<EnergySummary>> {
+    let config = RunConfig::read(&run.join(CONFIG_FILE))?;
+    let scene_dir = config
+        .scene
+        .clone()
+        .ok_or_else(|| Error::config("scene", "no scene directory in the run's config"))?;
+    let mut eval = config.eval.clone();
+    eval.energy_estimator = Some(estimator);
+    if pairs.is_some() {
+        eval.energy_pairs = pairs;
+    }
+    eval.validate()?;
+    let settings = eval.resolve(config.train.profile);
+    let device = brdf_neural::device::cpu();
+    let model = load_weights(&config, run, &device)?;
+    let dataset = SceneDataset::open(&scene_dir)?;
+    let samples = dataset.samples(Split::Test)?;
+    let cache = cache_dir_for(&config, run, cache);
+    let (spatial, dim) = spatial_features(&dataset, &samples, &config.features, &cache)?;
+    let data = TrainingData::new(&samples, &spatial, dim);
+    let brdf = ModelBrdf { model: &model, config: &config.model, data: &data, device: &device };
+    analyses::energy(&brdf, &settings, config.seed, progress)
+}
+
 /// Evaluates the finished run in `run`; `scene` overrides the config's scene directory.
 pub fn eval(
     run: &Path,
