@@ -11,11 +11,10 @@
 //!    at the origin, the translation that puts the sphere's centre on the ray through the
 //!    circle's centre at the distance where its angular radius equals the circle's (averaged
 //!    over eight directions, since the pixels need not be square).
-//! 4. [`normal_error`]: the angle between the mesh's interpolated normals and the benchmark's
-//!    ground-truth normal map, over the pixels in both the mask and the projection.
+//!
+//! The result is checked against the benchmark's normal map by [`crate::normal_check`].
 
-use crate::capture::diligent_to_opencv;
-use crate::report::{CircleFit, NormalCheck};
+use crate::report::CircleFit;
 use glam::{DMat3, DVec3, Vec3};
 use mesh_encoding::TriMesh;
 use std::collections::HashMap;
@@ -153,35 +152,6 @@ pub fn sphere_translation(k: DMat3, circle: &CircleFit) -> DVec3 {
         .sum::<f64>()
         / 8.0;
     axis / alpha.sin()
-}
-
-/// Angular error between mesh normals (world = OpenCV camera frame) at `pixels` and a
-/// ground-truth normal map in DiLiGenT's frame, `gt(row, col)`; pixels without a ground-truth
-/// normal (zero vector) are skipped. `None` when no pixel compares.
-pub fn normal_error(
-    pixels: impl Iterator<Item = (usize, Vec3)>,
-    width: usize,
-    gt: impl Fn(usize, usize) -> [f64; 3],
-) -> Option<NormalCheck> {
-    let mut errs: Vec<f64> = Vec::new();
-    for (p, n) in pixels {
-        let g = DVec3::from_array(gt(p / width, p % width));
-        let Some(g) = g.try_normalize() else { continue };
-        let m = DVec3::from_array(diligent_to_opencv(n.as_dvec3().to_array()));
-        errs.push(m.normalize().dot(g).clamp(-1.0, 1.0).acos().to_degrees());
-    }
-    if errs.is_empty() {
-        return None;
-    }
-    errs.sort_by(f64::total_cmp);
-    let q = |f: f64| errs[((errs.len() - 1) as f64 * f).round() as usize];
-    Some(NormalCheck {
-        pixels: errs.len(),
-        mean_deg: errs.iter().sum::<f64>() / errs.len() as f64,
-        median_deg: q(0.5),
-        p95_deg: q(0.95),
-        max_deg: errs[errs.len() - 1],
-    })
 }
 
 #[cfg(test)]

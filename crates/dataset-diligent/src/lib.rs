@@ -14,9 +14,12 @@
 //! Modules:
 //! * [`capture`]: one capture directory (16-bit PNGs, light files, mask) with its checks and
 //!   DiLiGenT's camera axes.
+//! * [`calibration`]: DiLiGenT-MV's `Calib_Results.mat` cameras (non-orthonormal rotations
+//!   factored into the intrinsics).
 //! * [`mat5`]: a MATLAB v5 reader (numeric arrays, compressed variables) and a writer.
 //! * [`decimate`]: quadric-error edge collapse to a target vertex count.
 //! * [`ball`]: the ball's sphere model (circle fit, icosphere, placement, normal check).
+//! * [`normal_check`]: the mesh's normals against the benchmark's `Normal_gt.mat` maps.
 //! * [`split`]: the train/test choice of views and lights.
 //! * [`report`]: what an import did.
 //!
@@ -37,11 +40,13 @@
 //! ```
 
 pub mod ball;
+pub mod calibration;
 pub mod capture;
 pub mod decimate;
 mod error;
 pub mod mat5;
 pub mod multi_view;
+pub mod normal_check;
 pub mod report;
 mod scene_writer;
 pub mod single_view;

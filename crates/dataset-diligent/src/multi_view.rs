@@ -9,26 +9,28 @@
 //! | `Calib_Results.mat` | `KK` (3 x 3, shared) and per view `Rc_i` (3 x 3), `Tc_i` (3 x 1), i = 1..N (also `Rc_01`); `kc` distortion, if present and non-zero, is reported as ignored |
 //! | `mesh_Gt.ply` (or the only `.ply`) | the ground-truth mesh in the calibration's world frame |
 //!
-//! Cameras follow the Caltech toolbox: x_c = Rc x_w + Tc, KK with the principal point in
-//! integer-pixel-centre coordinates, to which [`MultiViewOptions::principal_point_offset`] (0.5)
-//! is added for this project's +0.5 pixel centres. Light directions are in each view's camera
-//! frame (DiLiGenT's axes, see [`crate::capture`]) and go to the world as Rc^T (x, -y, -z).
+//! Cameras: see [`crate::calibration`] (x_c = Rc x_w + Tc; the principal point gets
+//! [`MultiViewOptions::principal_point_offset`]; non-orthonormal Rc are factored exactly into
+//! the intrinsics). Light directions are in each view's camera frame (DiLiGenT's axes, see
+//! [`crate::capture`]) and go to the world as R^T (x, -y, -z). When a view ships its
+//! `Normal_gt.mat`, the mesh's normals are compared with it ([`crate::normal_check`]).
 //!
 //! The mesh is cleaned, decimated to [`MultiViewOptions::target_vertices`] (quadric error, see
 //! [`crate::decimate`]; normals are recomputed from the result by the ray casting), then moved
 //! into the unit sphere with the cameras moved along (t' = s (R c + t) for x' = s (x - c)).
 //! Split: alternate views (or a list) x seeded disjoint light sets, see [`crate::split`].
 
+use crate::calibration::Calibration;
 use crate::capture::Capture;
 use crate::decimate::{DecimateOptions, decimate};
 use crate::error::{Error, Result};
-use crate::mat5::MatFile;
+use crate::normal_check::{read_normal_map, summarize, view_errors};
 use crate::report::ImportReport;
 use crate::scene_writer::{CapturedScene, ViewSpec, write_scene};
 use crate::single_view::object_name;
 use crate::split::{split_lights, train_views};
 use dataset_merl::scene::manifest::Split;
-use glam::{DMat3, DVec3};
+use glam::DMat3;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -112,27 +114,6 @@ fn find_mesh(dir: &Path) -> Result<PathBuf> {
     }
 }
 
-/// One camera from the calibration: (R rows, t).
-fn camera(mat: &MatFile, view: usize) -> Result<(DMat3, DVec3)> {
-    let (a, b) = (format!("Rc_{view}"), format!("Rc_{view:02}"));
-    let r = mat.matrix(&[&a, &b], 3, 3)?;
-    let (a, b) = (format!("Tc_{view}"), format!("Tc_{view:02}"));
-    let t = mat.vector(&[&a, &b], 3)?;
-    let r = DMat3::from_cols_array(&[r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]]);
-    let t = DVec3::new(t[0], t[1], t[2]);
-    let orth = (r * r.transpose() - DMat3::IDENTITY).to_cols_array();
-    if orth.iter().any(|e| e.is_nan() || e.abs() >= 1e-3)
-        || (r.determinant() - 1.0).abs() > 1e-3
-        || !t.is_finite()
-    {
-        return Err(Error::Mat {
-            path: mat.path.clone(),
-            fault: format!("`Rc_{view}` is not a rotation or `Tc_{view}` is not finite"),
-        });
-    }
-    Ok((r, t))
-}
-
 fn rows(m: DMat3) -> [[f32; 3]; 3] {
     let t = m.transpose();
     [t.x_axis, t.y_axis, t.z_axis].map(|r| r.as_vec3().to_array())
@@ -185,30 +166,13 @@ pub fn import_multi_view(src: &Path, out: &Path, o: &MultiViewOptions) -> Result
     let (train, test) = split_lights(captures[0].len(), o.train_lights, o.test_lights, o.seed)?;
 
     let calib_path = o.calibration.clone().unwrap_or_else(|| src.join("Calib_Results.mat"));
-    let mat = MatFile::read(&calib_path)?;
-    let kk = mat.matrix(&["KK"], 3, 3)?;
-    if kk.iter().any(|x| !x.is_finite())
-        || kk[3] != 0.0
-        || kk[6] != 0.0
-        || kk[7] != 0.0
-        || kk[8] != 1.0
-    {
-        return Err(Error::Mat {
-            path: calib_path,
-            fault: format!("`KK` {kk:?} is not an upper-triangular intrinsic matrix"),
-        });
-    }
-    let mut warnings = Vec::new();
-    if let Some(kc) = mat.get("kc").and_then(|v| v.data.as_ref())
-        && kc.iter().any(|x| x.abs() > 1e-12)
-    {
-        warnings.push(format!(
-            "{}: lens distortion kc = {kc:?} ignored (images taken as undistorted)",
-            calib_path.display()
-        ));
-    }
-    let cams: Vec<(DMat3, DVec3)> =
-        (1..=o.views).map(|v| camera(&mat, v)).collect::<Result<_>>()?;
+    let calib = Calibration::read(&calib_path, o.views, o.principal_point_offset)?;
+    let mut warnings = calib.warnings.clone();
+    // Ground-truth normal maps of the views, when shipped, read before anything is written.
+    let normal_maps = captures
+        .iter()
+        .map(|c| read_normal_map(&c.dir, c.width, c.height))
+        .collect::<Result<Vec<_>>>()?;
 
     let mesh_path = match &o.mesh {
         Some(p) => p.clone(),
@@ -235,20 +199,22 @@ pub fn import_multi_view(src: &Path, out: &Path, o: &MultiViewOptions) -> Result
     let sim = mesh.normalize_unit_sphere();
     let (c, s) = (sim.center.as_dvec3(), sim.scale as f64);
 
-    let pp = o.principal_point_offset;
-    let k = [
-        [kk[0] as f32, kk[1] as f32, (kk[2] + pp) as f32],
-        [0.0, kk[4] as f32, (kk[5] + pp) as f32],
-        [0.0, 0.0, 1.0],
-    ];
-    let views = cams
+    let views = calib
+        .cameras
         .iter()
         .enumerate()
-        .map(|(v, (r, t))| {
+        .map(|(v, cam)| {
             let split = if is_train[v] { Split::Train } else { Split::Test };
             let lights = if is_train[v] { train.clone() } else { test.clone() };
-            let t = s * (*r * c + *t);
-            ViewSpec { k, r: rows(*r), t: t.as_vec3().to_array(), split, capture: v, lights }
+            let t = s * (cam.r * c + cam.t);
+            ViewSpec {
+                k: rows(cam.k),
+                r: rows(cam.r),
+                t: t.as_vec3().to_array(),
+                split,
+                capture: v,
+                lights,
+            }
         })
         .collect();
     let object = object_name(src);
@@ -265,6 +231,16 @@ pub fn import_multi_view(src: &Path, out: &Path, o: &MultiViewOptions) -> Result
         shadow_bias_relative: o.shadow_bias_relative,
     };
     let written = write_scene(&scene, out, o.progress)?;
+    let mut errs = Vec::new();
+    for (v, map) in normal_maps.iter().enumerate() {
+        if let Some(map) = map {
+            let r = calib.cameras[v].r.as_mat3();
+            errs.extend(view_errors(&written.geometry.views[v], &captures[v].mask, r, map));
+        }
+    }
+    if normal_maps.iter().any(Option::is_some) && normal_maps.iter().any(Option::is_none) {
+        warnings.push("only some views have Normal_gt.mat; the normal check covers those".into());
+    }
     Ok(ImportReport {
         dir: out.into(),
         label: written.manifest.label.clone(),
@@ -276,7 +252,7 @@ pub fn import_multi_view(src: &Path, out: &Path, o: &MultiViewOptions) -> Result
         mesh_triangles: scene.mesh.triangles.len(),
         decimation,
         circle: None,
-        normal_check: None,
+        normal_check: summarize(errs),
         warnings,
     })
 }

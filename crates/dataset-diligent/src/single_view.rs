@@ -11,15 +11,15 @@
 //! view 1 (test) the test lights, with the same camera, so `pairs(Train)` and `pairs(Test)`
 //! never share a light ([`crate::split::split_lights`]).
 
-use crate::ball::{fit_circle, icosphere, normal_error, sphere_translation};
+use crate::ball::{fit_circle, icosphere, sphere_translation};
 use crate::capture::Capture;
 use crate::error::{Error, Result};
-use crate::mat5::MatFile;
+use crate::normal_check::{read_normal_map, summarize, view_errors};
 use crate::report::ImportReport;
 use crate::scene_writer::{CapturedScene, ViewSpec, write_scene};
 use crate::split::split_lights;
 use dataset_merl::scene::manifest::Split;
-use glam::DMat3;
+use glam::{DMat3, Mat3};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -131,21 +131,7 @@ pub fn import_single_view(src: &Path, out: &Path, o: &SingleViewOptions) -> Resu
     let k64 = DMat3::from_cols_array_2d(&k.map(|r| r.map(f64::from))).transpose();
     let t = sphere_translation(k64, &circle);
     // The ground-truth normal map, read (and checked) before anything is written.
-    let gt_path = src.join("Normal_gt.mat");
-    let (h, w) = (capture.height as usize, capture.width as usize);
-    let gt = if gt_path.is_file() {
-        let mat = MatFile::read(&gt_path)?;
-        let var = mat.numeric(&["Normal_gt"])?.clone();
-        if var.dims != [h, w, 3] {
-            return Err(Error::Mat {
-                path: gt_path,
-                fault: format!("`Normal_gt` is {}, expected {h} x {w} x 3", var.shape()),
-            });
-        }
-        Some(var)
-    } else {
-        None
-    };
+    let gt = read_normal_map(src, capture.width, capture.height)?;
     let (train, test) = split_lights(capture.len(), o.train_lights, o.test_lights, o.seed)?;
     let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     let t32 = t.as_vec3().to_array();
@@ -173,12 +159,7 @@ pub fn import_single_view(src: &Path, out: &Path, o: &SingleViewOptions) -> Resu
     let written = write_scene(&scene, out, o.progress)?;
 
     let normal_check = gt.and_then(|var| {
-        let g = &written.geometry.views[0];
-        let mask = &captures[0].mask;
-        let pixels = (0..g.len())
-            .filter(|&k| mask[g.pixels[k] as usize])
-            .map(|k| (g.pixels[k] as usize, g.normals[k]));
-        normal_error(pixels, w, |r, c| [0, 1, 2].map(|ch| var.at(&[r, c, ch]).unwrap_or(0.0)))
+        summarize(view_errors(&written.geometry.views[0], &captures[0].mask, Mat3::IDENTITY, &var))
     });
     Ok(ImportReport {
         dir: out.into(),

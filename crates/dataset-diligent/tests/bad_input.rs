@@ -122,6 +122,23 @@ fn multi_view_faults_name_the_file() {
     });
     assert!(m.contains("Calib_Results.mat") && m.contains("Rc_2") && m.contains("3 x 2"), "{m}");
 
+    let m = import_error("mat-not-rotation", |s| {
+        let eye = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+        let twice = eye.map(|x| 2.0 * x);
+        let bytes = write_mat5(
+            &[
+                ("KK", &[3, 3], &eye),
+                ("Rc_1", &[3, 3], &eye),
+                ("Tc_1", &[3, 1], &[0.0; 3]),
+                ("Rc_2", &[3, 3], &twice),
+                ("Tc_2", &[3, 1], &[0.0; 3]),
+            ],
+            false,
+        );
+        std::fs::write(s.join("Calib_Results.mat"), bytes).unwrap();
+    });
+    assert!(m.contains("Calib_Results.mat") && m.contains("`Rc_2` is not a rotation"), "{m}");
+
     let m = import_error("mat-missing-var", |s| {
         let eye = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
         std::fs::write(s.join("Calib_Results.mat"), write_mat5(&[("KK", &[3, 3], &eye)], false))

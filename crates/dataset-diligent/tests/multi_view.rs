@@ -2,7 +2,7 @@
 //! compressed MAT v5 calibration, a PLY mesh): the scene opens with dataset-merl's
 //! `SceneDataset`, cameras, world lights and radiance are consistent (a Lambertian sphere's
 //! samples equal albedo x n . l), the split is the paper's shape, saturation is flagged, and
-//! the mesh is decimated.
+//! the mesh is decimated; the mesh's normals match the views' `Normal_gt.mat`.
 
 mod common;
 
@@ -31,7 +31,12 @@ fn miniature_imports_into_the_common_dataset_api() {
     eprintln!("miniature: {r:#?}");
     let d = r.decimation.unwrap();
     assert_eq!((d.vertices_before, d.vertices_after, r.mesh_vertices), (2562, 1000, 1000));
-    assert!(r.warnings.is_empty(), "{:?}", r.warnings);
+    // The stretched rotations are factored into the intrinsics, with one warning.
+    assert_eq!(r.warnings.len(), 1, "{:?}", r.warnings);
+    assert!(r.warnings[0].contains("not orthonormal"), "{:?}", r.warnings);
+    let nc = r.normal_check.unwrap();
+    eprintln!("miniature normals vs Normal_gt: {nc:?}");
+    assert!(nc.pixels > 2500 && nc.mean_deg < 1.5 && nc.max_deg < 8.0, "{nc:?}");
     assert_eq!(r.views.len(), 4);
     for (i, v) in r.views.iter().enumerate() {
         assert_eq!(v.split, if i % 2 == 0 { Split::Train } else { Split::Test });

@@ -47,8 +47,10 @@ pub fn shared(sub: &str) -> Option<PathBuf> {
 
 /// A miniature DiLiGenT-MV object written in the exact layout: a Lambertian sphere (albedo
 /// [`ALBEDO`], radius 50 mm at [`CENTRE`]) seen by `views` turntable cameras, `lights` lights
-/// per view, 64 x 48 16-bit PNGs, text files, masks, a compressed MAT v5 calibration and an
-/// ASCII PLY mesh (icosphere level 4, 2562 vertices, in mm).
+/// per view, 64 x 48 16-bit PNGs, text files, masks, per-view `Normal_gt.mat`, a compressed MAT
+/// v5 calibration and an ASCII PLY mesh (icosphere level 4, 2562 vertices, in mm). Like the
+/// real calibration, the stored rotations are not orthonormal: Rc = [`STRETCH`] Q with the
+/// stretch compensated in KK and Tc, so the projection is the true one.
 pub mod miniature {
     use dataset_diligent::mat5::write_mat5;
     use glam::{DMat3, DVec3};
@@ -62,6 +64,8 @@ pub mod miniature {
     pub const H: u32 = 48;
     /// KK (Caltech toolbox convention, pixel centres at integers).
     pub const KK: [[f64; 3]; 3] = [[450.0, 0.0, 31.5], [0.0, 452.0, 23.5], [0.0, 0.0, 1.0]];
+    /// The first row of every stored rotation is this much too long (as in DiLiGenT-MV).
+    pub const STRETCH: f64 = 1.003458;
 
     /// Camera v (0-based): on a circle of radius 1500 mm around the centre, looking at it.
     pub fn pose(v: usize) -> (DMat3, DVec3) {
@@ -104,16 +108,17 @@ pub mod miniature {
     pub fn write(root: &Path, views: usize, lights: usize) -> PathBuf {
         let obj = root.join("mvpmsData/miniPNG");
         let k = DMat3::from_cols_array_2d(&KK).transpose();
+        let stretch = DMat3::from_diagonal(DVec3::new(STRETCH, 1.0, 1.0));
         let mut vars: Vec<(String, Vec<usize>, Vec<f64>)> = Vec::new();
         let col_major = |m: DMat3| m.to_cols_array().to_vec();
-        vars.push(("KK".into(), vec![3, 3], col_major(k)));
+        vars.push(("KK".into(), vec![3, 3], col_major(k * stretch.inverse())));
         vars.push(("kc".into(), vec![5, 1], vec![0.0; 5]));
         for v in 0..views {
             let dir = obj.join(format!("view_{:02}", v + 1));
             std::fs::create_dir_all(&dir).unwrap();
             let (r, t) = pose(v);
-            vars.push((format!("Rc_{}", v + 1), vec![3, 3], col_major(r)));
-            vars.push((format!("Tc_{}", v + 1), vec![3, 1], t.to_array().to_vec()));
+            vars.push((format!("Rc_{}", v + 1), vec![3, 3], col_major(stretch * r)));
+            vars.push((format!("Tc_{}", v + 1), vec![3, 1], (stretch * t).to_array().to_vec()));
             let centre = -(r.transpose() * t);
             let (mut dirs, mut ints) = (String::new(), String::new());
             for i in 0..lights {
@@ -136,6 +141,19 @@ pub mod miniature {
             }
             let m = image::RgbImage::from_raw(W, H, mask).unwrap();
             m.save(dir.join("mask.png")).unwrap();
+            // Ground-truth normals in DiLiGenT's camera frame, H x W x 3 column-major.
+            let (w, h) = (W as usize, H as usize);
+            let mut normals = vec![0.0; w * h * 3];
+            for (p, hit) in hits.iter().enumerate() {
+                if let Some(n) = hit {
+                    let c = r * *n;
+                    for (ch, x) in [c.x, -c.y, -c.z].into_iter().enumerate() {
+                        normals[p / w + h * (p % w) + h * w * ch] = x;
+                    }
+                }
+            }
+            let gt = write_mat5(&[("Normal_gt", &[h, w, 3], &normals)], true);
+            std::fs::write(dir.join("Normal_gt.mat"), gt).unwrap();
             for i in 0..lights {
                 let lc = light(i);
                 let l = (r.transpose() * DVec3::new(lc[0], -lc[1], -lc[2])).normalize();
