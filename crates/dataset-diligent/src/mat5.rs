@@ -263,7 +263,10 @@ impl Reader<'_> {
         let name = String::from_utf8_lossy(name_el.data).into_owned();
         let mut var = MatVariable { name, class, logical, dims, data: None };
         if let MatClass::Numeric(_) = class {
-            let count: usize = var.dims.iter().product();
+            let count =
+                var.dims.iter().try_fold(1usize, |a, &d| a.checked_mul(d)).ok_or_else(|| {
+                    self.fault(format!("variable `{}` dimensions overflow", var.name))
+                })?;
             let re = self.element(b, name_el.next)?;
             let data = self.numbers(re.ty, re.data)?;
             if data.len() != count {
@@ -521,6 +524,13 @@ mod tests {
         assert!(f.matrix(&["KK"], 3, 3).unwrap_err().to_string().contains("no variable `KK`"));
         let truncated = &good[..good.len() - 9];
         assert!(msg(truncated).contains("claims"), "{}", msg(truncated));
+        // Dimensions whose product overflows are an error, not a panic.
+        let mut huge = write_mat5(&[("h", &[1, 1, 1], &[1.0])], false);
+        let dims_at = 128 + 8 + 16 + 8;
+        for k in 0..3 {
+            huge[dims_at + 4 * k..dims_at + 4 * k + 4].copy_from_slice(&i32::MAX.to_le_bytes());
+        }
+        assert!(msg(&huge).contains("overflow"), "{}", msg(&huge));
         let mut z = write_mat5(&[("x", &[1, 1], &[1.0])], true);
         let n = z.len();
         z[n - 6] ^= 0xff;
