@@ -127,7 +127,11 @@ pub fn eval(
 
     let mut rmse = CubeRootRmse::new(RmseConfig::default());
     for (r, &i) in data.source.iter().enumerate() {
-        rmse.push(pred.f[r], samples.gt_brdf[i], data.l[r][2], data.v[r][2], samples.saturated[i]);
+        // Samples without a valid ground truth (invalid MERL bins, captured data) are left out.
+        if samples.gt_valid[i] {
+            let (lz, vz) = (data.l[r][2], data.v[r][2]);
+            rmse.push(pred.f[r], samples.gt_brdf[i], lz, vz, samples.saturated[i]);
+        }
     }
     let rmse_cbrt = if rmse.kept > 0 { Some(rmse.value()?) } else { None };
 
