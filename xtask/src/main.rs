@@ -5,6 +5,7 @@
 //! until then the main job is `analytic-report`, which characterises the analytic BRDF library.
 
 mod analytic_report;
+mod fetch;
 mod generate_scenes;
 
 use anyhow::Result;
@@ -66,6 +67,28 @@ enum Command {
         #[arg(long, default_value = "datasets/semi-synthetic")]
         out: PathBuf,
     },
+    /// Download a dataset of `data-manifests/` (resumable, sha256-verified) into the data root.
+    FetchData {
+        /// Manifest name (`merl`, `nbrdf`, `meshes`, `diligent`, `diligent-mv`, `lpips`).
+        #[arg(required_unless_present = "list")]
+        name: Option<String>,
+        /// Data root [default: $NEURAL_BRDF_DATA, else ./data].
+        #[arg(long)]
+        dest: Option<PathBuf>,
+        /// Fetch only this entry of the manifest; repeatable.
+        #[arg(long)]
+        only: Vec<String>,
+        /// Print the manifests (or the named one) and their entries, fetch nothing.
+        #[arg(long)]
+        list: bool,
+        /// Accept files whose manifest publishes no sha256, recording the computed hash in
+        /// `<root>/fetch-lock.toml` so later fetches verify against it.
+        #[arg(long)]
+        allow_unverified: bool,
+        /// Directory of the manifests [default: the workspace's data-manifests/].
+        #[arg(long)]
+        manifests: Option<PathBuf>,
+    },
     /// Print the workspace's crates in layering order (bottom first).
     Layers,
 }
@@ -91,6 +114,9 @@ fn main() -> Result<()> {
                 merl_dir,
                 out,
             })?;
+        }
+        Command::FetchData { name, dest, only, list, allow_unverified, manifests } => {
+            fetch::run(fetch::Options { name, dest, only, list, allow_unverified, manifests })?;
         }
         Command::Layers => {
             for c in LAYERS {

@@ -1,0 +1,242 @@
+//! One HTTP(S) download into `<file>.part`: resumes an existing part with a `Range` request,
+//! restarts when the server ignores it, retries transfers cut midway (resuming each time), hashes
+//! while it writes, and shows a byte bar. Errors name the URL or the file and the fault.
+
+use super::progress::{bytes_bar, hash_into, hex};
+use anyhow::{Context, Result, anyhow};
+use sha2::{Digest, Sha256};
+use std::fs::OpenOptions;
+use std::io::{Read, Seek, SeekFrom, Write};
+use std::path::Path;
+use std::time::Duration;
+
+/// Attempts per file (the first one included) before a transfer error is final.
+const ATTEMPTS: u32 = 4;
+
+/// A finished download.
+#[derive(Debug)]
+pub struct Fetched {
+    /// sha256 of the whole part file (hex).
+    pub sha256: String,
+    /// Its length in bytes.
+    pub len: u64,
+    /// Bytes that were already there and kept (0 for a fresh download).
+    pub resumed_from: u64,
+}
+
+/// Why one attempt stopped.
+enum Fault {
+    /// Worth another attempt (connection cut, 5xx, a part the server would not resume).
+    Retry(anyhow::Error),
+    /// Final (4xx, unreachable host, disk error).
+    Fatal(anyhow::Error),
+}
+
+/// Downloads `url` into `part` (resuming what is there), `expected_size` bytes if known.
+pub fn download(
+    url: &str,
+    part: &Path,
+    expected_size: Option<u64>,
+    label: &str,
+) -> Result<Fetched> {
+    check_scheme(url)?;
+    let agent = ureq::AgentBuilder::new()
+        .timeout_connect(Duration::from_secs(30))
+        .timeout_read(Duration::from_secs(60))
+        .redirects(8)
+        .user_agent(concat!("neural-brdfs-xtask/", env!("CARGO_PKG_VERSION")))
+        .build();
+    let mut last = None;
+    for attempt in 1..=ATTEMPTS {
+        match attempt_once(&agent, url, part, expected_size, label) {
+            Ok(f) => return Ok(f),
+            Err(Fault::Fatal(e)) => return Err(e),
+            Err(Fault::Retry(e)) => {
+                if attempt < ATTEMPTS {
+                    eprintln!("    {e:#}; retrying ({attempt}/{})", ATTEMPTS - 1);
+                    std::thread::sleep(Duration::from_millis(300 * u64::from(attempt)));
+                }
+                last = Some(e);
+            }
+        }
+    }
+    let e = last.unwrap_or_else(|| anyhow!("no attempt was made"));
+    Err(e.context(format!("giving up on {url} after {ATTEMPTS} attempts")))
+}
+
+#[cfg(feature = "tls")]
+fn check_scheme(_url: &str) -> Result<()> {
+    Ok(())
+}
+
+#[cfg(not(feature = "tls"))]
+fn check_scheme(url: &str) -> Result<()> {
+    anyhow::ensure!(
+        !url.starts_with("https://"),
+        "{url}: this xtask was built without its `tls` feature and cannot fetch https URLs \
+         (build it with default features)"
+    );
+    Ok(())
+}
+
+fn attempt_once(
+    agent: &ureq::Agent,
+    url: &str,
+    part: &Path,
+    expected_size: Option<u64>,
+    label: &str,
+) -> Result<Fetched, Fault> {
+    let disk = |what: &str| {
+        let msg = format!("{what} {}", part.display());
+        move |e: std::io::Error| Fault::Fatal(anyhow!(e).context(msg))
+    };
+    let mut offset = match std::fs::metadata(part) {
+        Ok(m) => m.len(),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => 0,
+        Err(e) => return Err(disk("reading")(e)),
+    };
+    if expected_size.is_some_and(|s| offset > s) {
+        truncate(part).map_err(Fault::Fatal)?;
+        offset = 0;
+    }
+    let mut hasher = Sha256::new();
+    if offset > 0 {
+        hash_into(&mut hasher, part, Some(offset), &format!("{label} (partial)"))
+            .map_err(Fault::Fatal)?;
+        if expected_size == Some(offset) {
+            return Ok(Fetched {
+                sha256: hex(&hasher.finalize()),
+                len: offset,
+                resumed_from: offset,
+            });
+        }
+    }
+    let mut request = agent.get(url);
+    if offset > 0 {
+        request = request.set("Range", &format!("bytes={offset}-"));
+    }
+    let response = match request.call() {
+        Ok(r) => r,
+        Err(ureq::Error::Status(416, r)) if offset > 0 => {
+            // Nothing left past `offset`: the part is complete if the server's total says so.
+            if content_range(r.header("Content-Range")).is_some_and(|(_, t)| t == Some(offset)) {
+                return Ok(Fetched {
+                    sha256: hex(&hasher.finalize()),
+                    len: offset,
+                    resumed_from: offset,
+                });
+            }
+            truncate(part).map_err(Fault::Fatal)?;
+            return Err(Fault::Retry(anyhow!(
+                "GET {url}: HTTP 416 for a part of {offset} bytes; starting again from 0"
+            )));
+        }
+        Err(ureq::Error::Status(code, r)) => {
+            let e = anyhow!("GET {url}: HTTP {code} {}", r.status_text());
+            return Err(if code >= 500 || code == 408 || code == 429 {
+                Fault::Retry(e)
+            } else {
+                Fault::Fatal(e)
+            });
+        }
+        Err(ureq::Error::Transport(t)) => {
+            let e = anyhow!("GET {url}: {t}");
+            return Err(if t.kind() == ureq::ErrorKind::Io {
+                Fault::Retry(e)
+            } else {
+                Fault::Fatal(e)
+            });
+        }
+    };
+    let length = response.header("Content-Length").and_then(|v| v.trim().parse::<u64>().ok());
+    let (start, total) = if response.status() == 206 {
+        match content_range(response.header("Content-Range")) {
+            Some((s, total)) if s == offset => (offset, total.or(length.map(|l| l + offset))),
+            _ => {
+                truncate(part).map_err(Fault::Fatal)?;
+                return Err(Fault::Retry(anyhow!(
+                    "GET {url}: the server answered bytes={offset}- with a different range; \
+                     starting again from 0"
+                )));
+            }
+        }
+    } else {
+        if offset > 0 {
+            eprintln!("    {url}: the server ignored the Range request; downloading it whole");
+            hasher = Sha256::new();
+        }
+        (0, length)
+    };
+    let mut file = OpenOptions::new()
+        .create(true)
+        .write(true)
+        .truncate(false)
+        .open(part)
+        .map_err(disk("opening"))?;
+    file.set_len(start).map_err(disk("truncating"))?;
+    file.seek(SeekFrom::Start(start)).map_err(disk("seeking in"))?;
+    let mut writer = std::io::BufWriter::with_capacity(1 << 20, file);
+    let pb = bytes_bar(label, total.or(expected_size));
+    pb.set_position(start);
+    let mut reader = response.into_reader();
+    let mut buf = vec![0u8; 1 << 16];
+    let mut len = start;
+    loop {
+        let n = match reader.read(&mut buf) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => {
+                pb.finish_and_clear();
+                writer.flush().map_err(disk("writing"))?;
+                return Err(Fault::Retry(anyhow!(
+                    "GET {url}: the transfer broke off after {len} bytes ({e})"
+                )));
+            }
+        };
+        writer.write_all(&buf[..n]).map_err(disk("writing"))?;
+        hasher.update(&buf[..n]);
+        len += n as u64;
+        pb.inc(n as u64);
+    }
+    pb.finish_and_clear();
+    let file = writer.into_inner().map_err(|e| disk("writing")(e.into_error()))?;
+    file.sync_all().map_err(disk("syncing"))?;
+    if let Some(t) = total
+        && t != len
+    {
+        return Err(Fault::Retry(anyhow!("GET {url}: got {len} bytes of {t}")));
+    }
+    Ok(Fetched { sha256: hex(&hasher.finalize()), len, resumed_from: start })
+}
+
+/// Empties the part file (the next attempt starts from byte 0).
+fn truncate(part: &Path) -> Result<()> {
+    std::fs::write(part, b"").with_context(|| format!("truncating {}", part.display()))
+}
+
+/// Parses `bytes START-END/TOTAL` or `bytes */TOTAL` into (START, TOTAL); TOTAL may be `*`.
+fn content_range(value: Option<&str>) -> Option<(u64, Option<u64>)> {
+    let rest = value?.trim().strip_prefix("bytes")?.trim();
+    let (range, total) = rest.split_once('/')?;
+    let total = if total.trim() == "*" { None } else { Some(total.trim().parse().ok()?) };
+    if range.trim() == "*" {
+        return Some((u64::MAX, total));
+    }
+    let (start, _end) = range.split_once('-')?;
+    Some((start.trim().parse().ok()?, total))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::content_range;
+
+    #[test]
+    fn parses_content_range() {
+        assert_eq!(content_range(Some("bytes 10-19/20")), Some((10, Some(20))));
+        assert_eq!(content_range(Some("bytes 0-9/*")), Some((0, None)));
+        assert_eq!(content_range(Some("bytes */20")), Some((u64::MAX, Some(20))));
+        assert_eq!(content_range(Some("items 1-2/3")), None);
+        assert_eq!(content_range(None), None);
+    }
+}
