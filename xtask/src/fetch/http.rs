@@ -111,7 +111,8 @@ fn attempt_once(
             });
         }
     }
-    let mut request = agent.get(url);
+    // Bytes as stored: a compressed transfer would make byte offsets (resume) meaningless.
+    let mut request = agent.get(url).set("Accept-Encoding", "identity");
     if offset > 0 {
         request = request.set("Range", &format!("bytes={offset}-"));
     }
@@ -140,7 +141,10 @@ fn attempt_once(
             });
         }
         Err(ureq::Error::Transport(t)) => {
-            let e = anyhow!("GET {url}: {t}");
+            // ureq's message starts with the URL already.
+            let msg = t.to_string();
+            let msg = msg.strip_prefix(&format!("{url}: ")).unwrap_or(&msg).to_string();
+            let e = anyhow!("GET {url}: {msg}");
             return Err(if t.kind() == ureq::ErrorKind::Io {
                 Fault::Retry(e)
             } else {

@@ -7,6 +7,9 @@ use sha2::{Digest, Sha256};
 use std::io::Read;
 use std::path::Path;
 
+const WITH_TOTAL: &str = "{msg:24!} [{bar:30}] {bytes}/{total_bytes} {bytes_per_sec} eta {eta}";
+const WITHOUT_TOTAL: &str = "{msg:24!} {spinner} {bytes} {bytes_per_sec}";
+
 /// A byte-counting bar labelled `label`; `total` may be unknown. Indicatif hides it when stderr
 /// is not a terminal, so logs and tests see only the summary lines.
 pub fn bytes_bar(label: &str, total: Option<u64>) -> ProgressBar {
@@ -14,11 +17,7 @@ pub fn bytes_bar(label: &str, total: Option<u64>) -> ProgressBar {
         Some(t) => ProgressBar::new(t),
         None => ProgressBar::no_length(),
     };
-    let template = if total.is_some() {
-        "{msg:24!} [{bar:30}] {bytes}/{total_bytes} {bytes_per_sec} eta {eta}"
-    } else {
-        "{msg:24!} {spinner} {bytes} {bytes_per_sec}"
-    };
+    let template = if total.is_some() { WITH_TOTAL } else { WITHOUT_TOTAL };
     if let Ok(style) = ProgressStyle::with_template(template) {
         pb.set_style(style.progress_chars("=> "));
     }
@@ -60,4 +59,14 @@ pub fn sha256_file(path: &Path, label: &str) -> Result<(String, u64)> {
     let mut h = Sha256::new();
     let len = hash_into(&mut h, path, None, label)?;
     Ok((hex(&h.finalize()), len))
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn templates_parse() {
+        for t in [super::WITH_TOTAL, super::WITHOUT_TOTAL] {
+            assert!(indicatif::ProgressStyle::with_template(t).is_ok(), "{t}");
+        }
+    }
 }
