@@ -1,12 +1,15 @@
 //! `cargo xtask`: the orchestration CLI of the neural-BRDF comparison.
 //!
 //! Every user-facing job of the workspace is a subcommand here; run `cargo xtask --help`.
-//! The paper's full pipeline (`reproduce-tables`) lands with the training and evaluation issues;
-//! until then the main job is `analytic-report`, which characterises the analytic BRDF library.
+//! The main job is `reproduce-tables` (the paper's tables and figures from one command, see
+//! `docs/reproduce.md`); `collect` rebuilds them from any run directories, `fetch-data`
+//! downloads the real datasets, `import-diligent` turns a DiLiGenT capture into a scene.
 
 mod analytic_report;
 mod fetch;
 mod generate_scenes;
+mod import_diligent;
+mod reproduce;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -89,6 +92,66 @@ enum Command {
         #[arg(long)]
         manifests: Option<PathBuf>,
     },
+    /// Reproduce the paper's tables and figures: generate the profile's scenes, fit and evaluate
+    /// every run (finished runs are skipped, interrupted ones resume), then write the tables
+    /// (Markdown, LaTeX) and figures (PNG) into OUT/tables and OUT/figures.
+    ReproduceTables {
+        /// Built-in profile (smoke, quick, runtime, full) or a profile TOML file.
+        #[arg(long, default_value = experiments::sweep::DEFAULT_PROFILE)]
+        profile: String,
+        /// Output directory (scenes, runs, cache, tables, figures).
+        #[arg(long, default_value = "out/reproduce")]
+        out: PathBuf,
+        /// Runs at a time, as child processes (1: in this process).
+        #[arg(long, default_value_t = 1)]
+        jobs: usize,
+        /// Write one shell command per unfinished run to this file (e.g. for a Slurm job array)
+        /// instead of running them; then `cargo xtask collect`.
+        #[arg(long)]
+        emit_jobs: Option<PathBuf>,
+        /// Data root for the profile's `data:` meshes (default: $NEURAL_BRDF_DATA, else ./data).
+        #[arg(long)]
+        data: Option<PathBuf>,
+    },
+    /// Build every table and figure from the evaluated run directories below PATHS.
+    Collect {
+        /// Run directories or folders holding them.
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
+        /// Where tables/ and figures/ go.
+        #[arg(long, default_value = "out/collected")]
+        out: PathBuf,
+        /// Profile name the captions print.
+        #[arg(long, default_value = "collected")]
+        profile: String,
+    },
+    /// Fit (resuming) and evaluate one prepared run directory: what `--jobs` children and
+    /// `--emit-jobs` lines run.
+    RunOne {
+        /// The run directory.
+        run: PathBuf,
+        /// No progress bars.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Import a DiLiGenT capture (`pmsData/<obj>PNG`, the ball) or a DiLiGenT-MV object
+    /// (`mvpmsData/<obj>PNG`) as a scene directory that `experiments fit` trains on.
+    ImportDiligent {
+        /// The object's directory (`.../pmsData/ballPNG` or `.../mvpmsData/bearPNG`).
+        src: PathBuf,
+        /// Output scene directory.
+        #[arg(long)]
+        out: PathBuf,
+        /// Training lights (per view).
+        #[arg(long, default_value_t = 30)]
+        train_lights: usize,
+        /// Test lights (per view).
+        #[arg(long, default_value_t = 12)]
+        test_lights: usize,
+        /// DiLiGenT-MV: decimate the mesh to this many vertices.
+        #[arg(long, default_value_t = 100_000)]
+        target_vertices: usize,
+    },
     /// Print the workspace's crates in layering order (bottom first).
     Layers,
 }
@@ -117,6 +180,20 @@ fn main() -> Result<()> {
         }
         Command::FetchData { name, dest, only, list, allow_unverified, manifests } => {
             fetch::run(fetch::Options { name, dest, only, list, allow_unverified, manifests })?;
+        }
+        Command::ReproduceTables { profile, out, jobs, emit_jobs, data } => {
+            reproduce::reproduce(reproduce::Options {
+                profile,
+                out,
+                jobs,
+                emit_jobs,
+                data_root: data.unwrap_or_else(reproduce::default_data_root),
+            })?;
+        }
+        Command::Collect { paths, out, profile } => reproduce::collect(&paths, &out, &profile)?,
+        Command::RunOne { run, quiet } => reproduce::run_one(&run, !quiet)?,
+        Command::ImportDiligent { src, out, train_lights, test_lights, target_vertices } => {
+            import_diligent::run(&src, &out, train_lights, test_lights, target_vertices)?;
         }
         Command::Layers => {
             for c in LAYERS {

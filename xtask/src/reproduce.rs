@@ -1,0 +1,100 @@
+//! `cargo xtask reproduce-tables`, `collect` and `run-one`: the paper's results from one
+//! command (see `experiments::sweep` for the profiles, the run layout and the tables).
+
+use anyhow::{Context, Result};
+use experiments::sweep::{self, Execution, SweepProfile};
+use std::path::{Path, PathBuf};
+
+/// Options of `reproduce-tables`.
+pub struct Options {
+    /// Built-in profile name or TOML file.
+    pub profile: String,
+    /// Output directory.
+    pub out: PathBuf,
+    /// Concurrent runs (child processes); 1 runs in this process.
+    pub jobs: usize,
+    /// Write one command per unfinished run to this file instead of running.
+    pub emit_jobs: Option<PathBuf>,
+    /// Data root for `data:` meshes.
+    pub data_root: PathBuf,
+}
+
+/// The data root: `NEURAL_BRDF_DATA`, else `./data`.
+pub fn default_data_root() -> PathBuf {
+    std::env::var_os("NEURAL_BRDF_DATA").map(PathBuf::from).unwrap_or_else(|| PathBuf::from("data"))
+}
+
+/// The command that runs one run directory in a child process: this executable's `run-one`.
+fn run_one_command() -> Result<Vec<String>> {
+    let exe = std::env::current_exe().context("locating the xtask executable")?;
+    Ok(vec![exe.display().to_string(), "run-one".into()])
+}
+
+/// Runs `reproduce-tables`.
+pub fn reproduce(opts: Options) -> Result<()> {
+    let profile = SweepProfile::load(&opts.profile)?;
+    eprintln!("profile {}: {}", profile.name, profile.description);
+    let how = match (&opts.emit_jobs, opts.jobs) {
+        (Some(file), _) => Execution::Emit { file: file.clone(), command: run_one_command()? },
+        (None, 0 | 1) => Execution::InProcess,
+        (None, jobs) => Execution::Children { jobs, command: run_one_command()? },
+    };
+    let s = sweep::sweep(&profile, &opts.out, &opts.data_root, &how)
+        .with_context(|| format!("sweep {} into {}", profile.name, opts.out.display()))?;
+    eprintln!(
+        "\nscenes: {} generated, {} kept; runs: {} planned, {} finished earlier (skipped), {} completed now, {} failed",
+        s.scenes_generated,
+        s.scenes_kept,
+        s.runs.len(),
+        s.skipped,
+        s.completed,
+        s.failed.len()
+    );
+    for (dir, why) in &s.failed {
+        eprintln!("  failed: {}: {why}", dir.display());
+    }
+    if let Execution::Emit { file, .. } = &how {
+        eprintln!(
+            "wrote {} job command(s) to {} (one per line, e.g. for a Slurm array: \
+             sed -n \"${{SLURM_ARRAY_TASK_ID}}p\" {} | sh); then run `cargo xtask collect {}`",
+            s.emitted,
+            file.display(),
+            file.display(),
+            opts.out.join("runs").display()
+        );
+        return Ok(());
+    }
+    let c = sweep::collect(&[opts.out.join("runs")], &opts.out, &profile.name)?;
+    eprintln!("{} run(s) collected in {:.1} min", c.runs, s.seconds / 60.0);
+    print_results(&opts.out, &c.files);
+    anyhow::ensure!(
+        s.failed.is_empty(),
+        "{} run(s) failed (see above); the tables leave them out",
+        s.failed.len()
+    );
+    Ok(())
+}
+
+fn print_results(out: &Path, files: &[PathBuf]) {
+    let t1 = out.join("tables/table1.md");
+    if let Ok(text) = std::fs::read_to_string(&t1) {
+        println!("{text}");
+    }
+    eprintln!("tables and figures ({} files) in {}:", files.len(), out.display());
+    for f in files {
+        eprintln!("  {}", f.display());
+    }
+}
+
+/// Runs `collect`.
+pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<()> {
+    let c = sweep::collect(paths, out, profile)?;
+    eprintln!("{} evaluated run(s) collected, {} unfinished left out", c.runs, c.unfinished);
+    print_results(out, &c.files);
+    Ok(())
+}
+
+/// Runs `run-one` (what `--jobs` children and emitted job lines execute).
+pub fn run_one(dir: &Path, progress: bool) -> Result<()> {
+    sweep::run_one(dir, progress).with_context(|| format!("run {}", dir.display()))
+}
