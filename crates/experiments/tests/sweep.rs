@@ -99,3 +99,36 @@ fn a_miniature_sweep_produces_every_table_and_resumes() {
     assert!(text.lines().all(|l| l.starts_with("run-one /")), "{text}");
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// The built-in smoke profile (the shipped Spot mesh, no shared data needed): all 9 models and
+/// every ablation on 2 scenes, every table and figure written, nothing failed.
+#[test]
+fn the_smoke_profile_runs_end_to_end() {
+    let out = std::env::temp_dir().join(format!("experiments-smoke-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let profile = SweepProfile::load("smoke").unwrap();
+    let s =
+        sweep::sweep(&profile, &out, std::path::Path::new("data"), &Execution::InProcess).unwrap();
+    assert!(s.failed.is_empty(), "{:?}", s.failed);
+    assert_eq!((s.runs.len(), s.completed), (92, 92));
+    let c = sweep::collect(&[out.join("runs")], &out, "smoke").unwrap();
+    assert_eq!(c.runs, 92);
+    for t in ["table1", "nol", "reciprocity", "reciprocity-deltas", "angles", "nerfactor", "energy"]
+    {
+        let md = std::fs::read_to_string(out.join(format!("tables/{t}.md"))).unwrap();
+        assert!(md.contains("Profile: smoke"), "{t}:\n{md}");
+        if t == "table1" {
+            assert!(!md.contains("| – |"), "every Table 1 cell was run:\n{md}");
+        }
+        assert!(out.join(format!("tables/{t}.tex")).is_file());
+    }
+    // The mapping makes every purely neural model exactly reciprocal.
+    let recip = std::fs::read_to_string(out.join("tables/reciprocity.md")).unwrap();
+    let neural =
+        ["| Single MLP", "| Add. Sep.", "| Add. Shared", "| Enh. Add. Sep.", "| Enh. Add. Shared"];
+    for line in recip.lines().filter(|l| neural.iter().any(|n| l.starts_with(n))) {
+        let mapping = line.trim_end_matches('|').rsplit('|').next().unwrap().trim();
+        assert_eq!(mapping.trim_matches('*'), "0.0000", "{line}");
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -76,7 +76,11 @@ pub fn read_run(dir: &Path) -> Result<Option<CollectedRun>> {
                 .and_then(|s| s.file_name())
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_else(|| "unknown".into());
-            (object, Dataset::MerlNbrdf, vec![Purpose::Table, Purpose::Ablation])
+            (
+                object,
+                scene_dataset(config.scene.as_deref()),
+                vec![Purpose::Table, Purpose::Ablation],
+            )
         }
     };
     let opt = |v: Option<f64>, why: &str| match v {
@@ -104,6 +108,19 @@ pub fn read_run(dir: &Path) -> Result<Option<CollectedRun>> {
         r = r.with(MetricKind::EnergyMedianAbove1, opt(e.median_above_one, "no pair above 1"));
     }
     Ok(Some(CollectedRun { dir: dir.to_path_buf(), config, purposes, record: r }))
+}
+
+/// The data set of a scene directory, from its manifest: captured scenes name their benchmark,
+/// everything else is MERL-derived.
+fn scene_dataset(scene: Option<&Path>) -> Dataset {
+    use dataset_merl::scene::{Manifest, MaterialSpec, manifest::MANIFEST_FILE};
+    match scene.and_then(|s| Manifest::read(&s.join(MANIFEST_FILE)).ok()) {
+        Some(m) => match m.config.material {
+            MaterialSpec::Captured { benchmark, .. } => Dataset::from_label(&benchmark),
+            _ => Dataset::MerlNbrdf,
+        },
+        None => Dataset::MerlNbrdf,
+    }
 }
 
 /// What [`collect`] wrote.

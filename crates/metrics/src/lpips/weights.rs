@@ -6,7 +6,7 @@
 //! torchvision's AlexNet `features` (indices 0, 3, 6, 8, 10) and `lin{0..4}.weight` (1, C, 1, 1)
 //! from LPIPS v0.1 `alex.pth` (`lin{k}.model.1.weight`).
 //!
-//! **Sources** (converted offline by `devtools/convert_lpips.py`, needs PyTorch):
+//! **Sources** (converted offline by `crates/metrics/devtools/convert_lpips.py`, needs PyTorch):
 //! * [`ALEXNET_URL`]: torchvision's ImageNet AlexNet;
 //! * [`LIN_URL`]: the LPIPS v0.1 linear layers.
 //!
