@@ -35,18 +35,9 @@ pub fn run(opts: Options) -> Result<()> {
     };
     anyhow::ensure!(!opts.meshes.is_empty(), "give at least one --mesh");
     anyhow::ensure!(!materials.is_empty(), "give at least one --material");
-    let defaults = SceneSettings::default();
     anyhow::ensure!(opts.views >= 2, "--views must be at least 2 (half train, half test)");
     anyhow::ensure!(opts.lights >= 2, "--lights must be at least 2");
-    let settings = SceneSettings {
-        width: opts.size,
-        height: opts.size,
-        views: opts.views,
-        train_views: opts.views / 2,
-        lights_per_view: opts.lights,
-        train_lights: (opts.lights * defaults.train_lights) / defaults.lights_per_view.max(1),
-        ..defaults
-    };
+    let settings = SceneSettings::with_counts(opts.size, opts.views, opts.lights);
     let total = opts.meshes.len() * materials.len();
     let mut done = 0;
     for mesh in &opts.meshes {

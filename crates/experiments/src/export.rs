@@ -12,9 +12,7 @@
 
 use crate::config::{RunConfig, SpatialKind};
 use crate::data::{TrainingData, lbo_table};
-use crate::eval::ModelBrdf;
-use crate::run_dir::CONFIG_FILE;
-use crate::train::{cache_dir_for, load_weights};
+use crate::eval::{FittedRun, ModelBrdf};
 use crate::{Error, Result};
 use angles::Rusinkiewicz;
 use dataset_merl::merl::format::TABLE_LEN;
@@ -138,19 +136,9 @@ pub fn export_merl(
     progress: bool,
 ) -> Result<MerlExport> {
     let start = std::time::Instant::now();
-    let mut config = RunConfig::read(&run.join(CONFIG_FILE))?;
-    if let Some(s) = scene {
-        config.scene = Some(s.to_path_buf());
-    }
-    let scene_dir = config
-        .scene
-        .clone()
-        .ok_or_else(|| Error::config("scene", "no scene directory (pass --scene)"))?;
-    let device = brdf_neural::device::cpu();
-    let model = load_weights(&config, run, &device)?;
-    let dataset = SceneDataset::open(&scene_dir)?;
-    let cache = cache_dir_for(&config, run, cache);
-    let (table, dim) = vertex_features(&dataset, &config, &cache)?;
+    let fitted = FittedRun::open(run, scene, cache)?;
+    let (config, dataset) = (&fitted.config, &fitted.dataset);
+    let (table, dim) = vertex_features(dataset, config, &fitted.cache)?;
     let n = dataset.mesh.positions.len();
     let vertex = match point {
         SurfacePoint::Vertex(v) if v < n => v,
@@ -161,14 +149,19 @@ pub fn export_merl(
             ));
         }
         SurfacePoint::Representative => representative_row(&table, dim)
-            .ok_or_else(|| Error::format(&scene_dir, "the mesh has no vertices"))?,
+            .ok_or_else(|| Error::format(&dataset.dir, "the mesh has no vertices"))?,
     };
     let data = TrainingData {
         spatial: table[vertex * dim..(vertex + 1) * dim].to_vec(),
         spatial_dim: dim,
         ..Default::default()
     };
-    let brdf = ModelBrdf { model: &model, config: &config.model, data: &data, device: &device };
+    let brdf = ModelBrdf {
+        model: &fitted.model,
+        config: &config.model,
+        data: &data,
+        device: &fitted.device,
+    };
     let (merl, below_horizon) = tabulate_merl(&brdf, 0, progress)?;
     merl.write(out).map_err(|e| Error::format(out, e.to_string()))?;
     Ok(MerlExport {

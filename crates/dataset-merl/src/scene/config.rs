@@ -92,6 +92,23 @@ pub enum UpAxis {
     Z,
 }
 
+impl SceneSettings {
+    /// The defaults with square `size` x `size` images, `views` cameras (half of them train)
+    /// and `lights` lights per view (train lights in the default 30 : 42 proportion).
+    pub fn with_counts(size: u32, views: usize, lights: usize) -> Self {
+        let d = Self::default();
+        Self {
+            width: size,
+            height: size,
+            views,
+            train_views: views / 2,
+            lights_per_view: lights,
+            train_lights: (lights * d.train_lights / d.lights_per_view.max(1)).max(1),
+            ..d
+        }
+    }
+}
+
 impl Default for SceneSettings {
     fn default() -> Self {
         let pi = std::f32::consts::PI;

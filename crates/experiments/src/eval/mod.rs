@@ -5,6 +5,7 @@
 //!   maps and the additive models' diffuse / specular / albedo figures.
 //! * [`analyses`]: energy conservation and the reciprocity RMSE on the test records.
 //! * [`predict`]: the model on CPU records, and as a [`metrics::BatchBrdf`].
+//! * [`fitted`]: a finished run opened for analysis (config, model, scene).
 //! * [`settings`]: the `[eval]` table of the run configuration.
 //!
 //! The cube-root RMSE runs over the lit test samples with theta_l, theta_v <= 80 degrees, not
@@ -13,21 +14,18 @@
 //! `lpips_unavailable` says why. Results go into `<run>/metrics.json` under `test`.
 
 pub mod analyses;
+pub mod fitted;
 pub mod images;
 pub mod predict;
 pub mod settings;
 
 pub use analyses::EnergySummary;
+pub use fitted::FittedRun;
 pub use predict::{ModelBrdf, Prediction, predict};
 pub use settings::{EnergyEstimator, EvalConfig, EvalSettings};
 
-use crate::config::RunConfig;
-use crate::data::{TrainingData, spatial_features};
-use crate::run_dir::{CONFIG_FILE, METRICS_FILE, RunMetrics};
-use crate::train::{cache_dir_for, load_weights};
-use crate::{Error, Result};
-use dataset_merl::SceneDataset;
-use dataset_merl::scene::Split;
+use crate::run_dir::{METRICS_FILE, RunMetrics};
+use crate::Result;
 use metrics::rmse::{CubeRootRmse, RmseConfig};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -75,26 +73,18 @@ pub fn energy_of_run(
     cache: Option<&Path>,
     progress: bool,
 ) -> Result<Option<EnergySummary>> {
-    let config = RunConfig::read(&run.join(CONFIG_FILE))?;
-    let scene_dir = config
-        .scene
-        .clone()
-        .ok_or_else(|| Error::config("scene", "no scene directory in the run's config"))?;
-    let mut eval = config.eval.clone();
+    let run = FittedRun::open(run, None, cache)?;
+    let mut eval = run.config.eval.clone();
     eval.energy_estimator = Some(estimator);
     if pairs.is_some() {
         eval.energy_pairs = pairs;
     }
     eval.validate()?;
-    let settings = eval.resolve(config.train.profile);
-    let device = brdf_neural::device::cpu();
-    let model = load_weights(&config, run, &device)?;
-    let dataset = SceneDataset::open(&scene_dir)?;
-    let samples = dataset.samples(Split::Test)?;
-    let cache = cache_dir_for(&config, run, cache);
-    let (spatial, dim) = spatial_features(&dataset, &samples, &config.features, &cache)?;
-    let data = TrainingData::new(&samples, &spatial, dim);
-    let brdf = ModelBrdf { model: &model, config: &config.model, data: &data, device: &device };
+    let settings = eval.resolve(run.config.train.profile);
+    let (_, data) = run.test_records()?;
+    let config = &run.config;
+    let brdf =
+        ModelBrdf { model: &run.model, config: &config.model, data: &data, device: &run.device };
     analyses::energy(&brdf, &settings, config.seed, progress)
 }
 
@@ -106,24 +96,13 @@ pub fn eval(
     progress: bool,
 ) -> Result<TestMetrics> {
     let start = Instant::now();
-    let mut config = RunConfig::read(&run.join(CONFIG_FILE))?;
-    if let Some(s) = scene {
-        config.scene = Some(s.to_path_buf());
-    }
-    let scene_dir = config
-        .scene
-        .clone()
-        .ok_or_else(|| Error::config("scene", "no scene directory (pass --scene)"))?;
+    let fitted = FittedRun::open(run, scene, cache)?;
+    let (config, device, model, dataset) =
+        (&fitted.config, &fitted.device, &fitted.model, &fitted.dataset);
     let settings = config.eval.resolve(config.train.profile);
-    let device = brdf_neural::device::cpu();
-    let model = load_weights(&config, run, &device)?;
-    let dataset = SceneDataset::open(&scene_dir)?;
-    let samples = dataset.samples(Split::Test)?;
-    let cache = cache_dir_for(&config, run, cache);
-    let (spatial, dim) = spatial_features(&dataset, &samples, &config.features, &cache)?;
-    let data = TrainingData::new(&samples, &spatial, dim);
+    let (samples, data) = fitted.test_records()?;
     let parts = config.model.kind.is_additive() && settings.images;
-    let pred = predict(&model, &config.model, &data, &device, parts)?;
+    let pred = predict(model, &config.model, &data, device, parts)?;
 
     let mut rmse = CubeRootRmse::new(RmseConfig::default());
     for (r, &i) in data.source.iter().enumerate() {
@@ -136,12 +115,12 @@ pub fn eval(
     let rmse_cbrt = if rmse.kept > 0 { Some(rmse.value()?) } else { None };
 
     let (lpips, lpips_unavailable) = if settings.lpips_weights.is_file() {
-        (Some(metrics::lpips::Lpips::load(&settings.lpips_weights, &device)?), None)
+        (Some(metrics::lpips::Lpips::load(&settings.lpips_weights, device)?), None)
     } else {
         (None, Some("weights missing".to_string()))
     };
     let scores = images::render_and_score(
-        &dataset,
+        dataset,
         &samples,
         &data,
         &pred,
@@ -150,7 +129,7 @@ pub fn eval(
         lpips.as_ref(),
         progress,
     )?;
-    let brdf = ModelBrdf { model: &model, config: &config.model, data: &data, device: &device };
+    let brdf = ModelBrdf { model, config: &config.model, data: &data, device };
     let reciprocity_rmse = analyses::reciprocity(&brdf, &settings)?;
     let energy = analyses::energy(&brdf, &settings, config.seed, progress)?;
     let test = TestMetrics {

@@ -93,16 +93,7 @@ pub fn prepare_scenes(
     summary: &mut SweepSummary,
 ) -> Result<Vec<PathBuf>> {
     let d = &profile.data;
-    let defaults = SceneSettings::default();
-    let settings = SceneSettings {
-        width: d.size,
-        height: d.size,
-        views: d.views,
-        train_views: d.views / 2,
-        lights_per_view: d.lights,
-        train_lights: (d.lights * defaults.train_lights / defaults.lights_per_view.max(1)).max(1),
-        ..defaults
-    };
+    let settings = SceneSettings::with_counts(d.size, d.views, d.lights);
     let mut dirs = Vec::new();
     for (i, s) in scenes.iter().enumerate() {
         let config = SceneConfig {

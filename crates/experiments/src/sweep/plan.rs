@@ -258,7 +258,7 @@ mod tests {
         assert_eq!(r.len(), 2 * (9 + 5 + 10 + 5 + 8) + 18);
         let runtime = SweepProfile::load("runtime").unwrap();
         let rt = runs(&runtime).unwrap();
-        assert_eq!(rt.len(), 45);
+        assert_eq!(rt.len(), 36);
         // The 400-step curve point equals the quick profile's Table 1 run on that scene.
         let q0 = &runs(&quick).unwrap()[0];
         assert!(rt.iter().any(|r| r.config == q0.config), "shared by content address");

@@ -1,0 +1,55 @@
+//! A finished run opened for analysis: its configuration, fitted model and scene, shared by
+//! `eval`, `energy` and `export-merl`.
+
+use crate::config::RunConfig;
+use crate::data::{TrainingData, spatial_features};
+use crate::run_dir::CONFIG_FILE;
+use crate::train::{cache_dir_for, load_weights};
+use crate::{Error, Result};
+use brdf_neural::BrdfModel;
+use burn::tensor::Device;
+use dataset_merl::scene::Split;
+use dataset_merl::{SampleSet, SceneDataset};
+use std::path::{Path, PathBuf};
+
+/// A finished run with its model loaded and its scene opened.
+pub struct FittedRun {
+    /// The run's configuration (`scene` possibly overridden).
+    pub config: RunConfig,
+    /// The device the model lives on.
+    pub device: Device,
+    /// The fitted model.
+    pub model: BrdfModel,
+    /// The scene.
+    pub dataset: SceneDataset,
+    /// The eigenpair / feature cache directory.
+    pub cache: PathBuf,
+}
+
+impl FittedRun {
+    /// Opens `run`; `scene` overrides the configured scene directory, `cache` the cache.
+    pub fn open(run: &Path, scene: Option<&Path>, cache: Option<&Path>) -> Result<Self> {
+        let mut config = RunConfig::read(&run.join(CONFIG_FILE))?;
+        if let Some(s) = scene {
+            config.scene = Some(s.to_path_buf());
+        }
+        let scene_dir = config
+            .scene
+            .clone()
+            .ok_or_else(|| Error::config("scene", "no scene directory (pass --scene)"))?;
+        let device = brdf_neural::device::cpu();
+        let model = load_weights(&config, run, &device)?;
+        let dataset = SceneDataset::open(&scene_dir)?;
+        let cache = cache_dir_for(&config, run, cache);
+        Ok(Self { config, device, model, dataset, cache })
+    }
+
+    /// The lit test samples and their training records (features, local directions).
+    pub fn test_records(&self) -> Result<(SampleSet, TrainingData)> {
+        let samples = self.dataset.samples(Split::Test)?;
+        let (spatial, dim) =
+            spatial_features(&self.dataset, &samples, &self.config.features, &self.cache)?;
+        let data = TrainingData::new(&samples, &spatial, dim);
+        Ok((samples, data))
+    }
+}
