@@ -17,7 +17,6 @@
 use crate::report::CircleFit;
 use glam::{DMat3, DVec3, Vec3};
 use mesh_encoding::TriMesh;
-use std::collections::HashMap;
 
 /// Fits a circle to the boundary of a row-major mask of `width` columns; `None` when the mask
 /// has fewer than 8 boundary points or they are collinear.
@@ -78,63 +77,9 @@ pub fn fit_circle(mask: &[bool], width: usize) -> Option<CircleFit> {
 /// A unit sphere from an icosahedron subdivided `level` times (10 4^level + 2 vertices),
 /// counter-clockwise seen from outside.
 pub fn icosphere(level: u32) -> TriMesh {
-    let g = (1.0 + 5.0_f32.sqrt()) / 2.0;
-    let mut pos: Vec<Vec3> = [
-        (-1.0, g, 0.0),
-        (1.0, g, 0.0),
-        (-1.0, -g, 0.0),
-        (1.0, -g, 0.0),
-        (0.0, -1.0, g),
-        (0.0, 1.0, g),
-        (0.0, -1.0, -g),
-        (0.0, 1.0, -g),
-        (g, 0.0, -1.0),
-        (g, 0.0, 1.0),
-        (-g, 0.0, -1.0),
-        (-g, 0.0, 1.0),
-    ]
-    .iter()
-    .map(|&(x, y, z)| Vec3::new(x, y, z).normalize())
-    .collect();
-    let mut tris: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..level {
-        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut midpoint = |a: u32, b: u32, pos: &mut Vec<Vec3>| {
-            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                pos.push((pos[a as usize] + pos[b as usize]).normalize());
-                pos.len() as u32 - 1
-            })
-        };
-        let mut next = Vec::with_capacity(tris.len() * 4);
-        for [a, b, c] in tris {
-            let (ab, bc, ca) =
-                (midpoint(a, b, &mut pos), midpoint(b, c, &mut pos), midpoint(c, a, &mut pos));
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        tris = next;
-    }
-    TriMesh { positions: pos, triangles: tris }
+    let (v, f) = mesh_encoding::mesh::icosphere(level as usize);
+    let positions = v.iter().map(|p| Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32)).collect();
+    TriMesh { positions, triangles: f }
 }
 
 /// The camera translation (R = I) that makes a unit sphere at the origin project onto `circle`

@@ -11,6 +11,7 @@ mod cleanup;
 mod io;
 mod normalize;
 mod normals;
+mod shapes;
 mod topology;
 
 use glam::{DVec3, Vec3};
@@ -21,6 +22,7 @@ pub use cleanup::CleanupReport;
 pub use io::{LoadOptions, LoadReport, LoadedMesh, MeshFormat, load_mesh};
 pub use normalize::Similarity;
 pub use normals::{NormalWeighting, interpolate_normal};
+pub use shapes::icosphere;
 pub use topology::Topology;
 
 /// An indexed triangle mesh.
