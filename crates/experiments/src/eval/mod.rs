@@ -24,8 +24,8 @@ pub use fitted::FittedRun;
 pub use predict::{ModelBrdf, Prediction, predict};
 pub use settings::{EnergyEstimator, EvalConfig, EvalSettings};
 
-use crate::run_dir::{METRICS_FILE, RunMetrics};
 use crate::Result;
+use crate::run_dir::{METRICS_FILE, RunMetrics};
 use metrics::rmse::{CubeRootRmse, RmseConfig};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
