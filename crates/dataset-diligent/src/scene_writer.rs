@@ -138,25 +138,10 @@ pub(crate) fn write_scene(s: &CapturedScene<'_>, out: &Path, progress: bool) -> 
     };
     config.validate()?;
 
-    let name = out.file_name().and_then(|n| n.to_str()).unwrap_or("scene");
-    let tmp = out.with_file_name(format!(".{name}.partial-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&tmp);
-    for sub in ["images", "brdf", "flags", "masks", "previews"] {
-        std::fs::create_dir_all(tmp.join(sub)).map_err(|e| Error::io(tmp.join(sub), e))?;
-    }
-    let result = assemble(s, &config, &views, infos, &tmp, progress);
-    let written = match result {
-        Ok(w) => w,
-        Err(e) => {
-            let _ = std::fs::remove_dir_all(&tmp);
-            return Err(e);
-        }
-    };
-    if out.exists() {
-        std::fs::remove_dir_all(out).map_err(|e| Error::io(out, e))?;
-    }
-    std::fs::rename(&tmp, out).map_err(|e| Error::io(out, e))?;
-    Ok(written)
+    let subdirs = ["images", "brdf", "flags", "masks", "previews"];
+    dataset_merl::atomic::write_dir_atomic(out, &subdirs, |tmp: &Path| {
+        assemble(s, &config, &views, infos, tmp, progress)
+    })
 }
 
 fn assemble(

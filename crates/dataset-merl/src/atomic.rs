@@ -1,5 +1,6 @@
-//! Atomic file writes: a temporary file in the destination's directory, flushed, then renamed
-//! over the destination, so a reader never sees a half-written file.
+//! Atomic writes: a file ([`write_atomic`]: a temporary file in the destination's directory,
+//! flushed, then renamed over it) or a whole directory ([`write_dir_atomic`]: assembled under a
+//! temporary sibling, then renamed into place), so a reader never sees a half-written one.
 
 use crate::error::{Error, Result};
 use std::io::Write;
@@ -21,4 +22,33 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         return Err(Error::io(&tmp, e));
     }
     std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
+}
+
+/// Builds the directory `out` atomically: `build` fills a fresh temporary sibling of `out`
+/// (with `subdirs` created), which then replaces `out`. On an error the temporary directory is
+/// removed and `out` is left as it was, so a reader never sees a half-written directory.
+pub fn write_dir_atomic<T, E: From<Error>>(
+    out: &Path,
+    subdirs: &[&str],
+    build: impl FnOnce(&Path) -> std::result::Result<T, E>,
+) -> std::result::Result<T, E> {
+    let name = out.file_name().and_then(|n| n.to_str()).unwrap_or("dir");
+    let tmp = out.with_file_name(format!(".{name}.partial-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    for sub in subdirs {
+        let d = tmp.join(sub);
+        std::fs::create_dir_all(&d).map_err(|e| Error::io(&d, e))?;
+    }
+    let value = match build(&tmp) {
+        Ok(v) => v,
+        Err(e) => {
+            let _ = std::fs::remove_dir_all(&tmp);
+            return Err(e);
+        }
+    };
+    if out.exists() {
+        std::fs::remove_dir_all(out).map_err(|e| Error::io(out, e))?;
+    }
+    std::fs::rename(&tmp, out).map_err(|e| Error::io(out, e))?;
+    Ok(value)
 }

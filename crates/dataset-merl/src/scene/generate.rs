@@ -155,13 +155,8 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
     let is_train = train_views(s.views, s.train_views, config.seed);
 
     // Assemble under a temporary name beside the target.
-    let name = out.file_name().and_then(|n| n.to_str()).unwrap_or("scene");
-    let tmp = out.with_file_name(format!(".{name}.partial-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&tmp);
-    for sub in ["images", "brdf", "flags", "masks", "previews"] {
-        std::fs::create_dir_all(tmp.join(sub)).map_err(|e| Error::io(tmp.join(sub), e))?;
-    }
-    let result = (|| {
+    let subdirs = ["images", "brdf", "flags", "masks", "previews"];
+    let manifest = crate::atomic::write_dir_atomic(out, &subdirs, |tmp: &Path| -> Result<_> {
         let settings = PrecomputeSettings {
             shadow_bias: ShadowBias::Relative(s.shadow_bias_relative),
             ..Default::default()
@@ -284,18 +279,7 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
         let path = tmp.join(MANIFEST_FILE);
         std::fs::write(&path, json).map_err(|e| Error::io(&path, e))?;
         Ok(manifest)
-    })();
-    let manifest = match result {
-        Ok(m) => m,
-        Err(e) => {
-            let _ = std::fs::remove_dir_all(&tmp);
-            return Err(e);
-        }
-    };
-    if out.exists() {
-        std::fs::remove_dir_all(out).map_err(|e| Error::io(out, e))?;
-    }
-    std::fs::rename(&tmp, out).map_err(|e| Error::io(out, e))?;
+    })?;
     Ok(GenerateReport {
         dir: out.into(),
         skipped: false,
