@@ -1,0 +1,93 @@
+//! The CPU backend as this workspace builds it: flex with the patch in `vendor/burn-flex`
+//! (matrix-product outputs allocated aligned instead of copied) and the host-memory policy.
+//!
+//! Matrix products and their gradients are compared with f64 references for output sizes on
+//! both sides of the patch (byte sizes that are and are not multiples of 16), for plain and
+//! transposed (strided) operands, and across repeated allocate-and-free cycles as a training
+//! step makes them.
+
+use brdf_neural::device;
+use burn::tensor::{Tensor, TensorData};
+
+/// Deterministic values in [-1, 1).
+fn values(n: usize, seed: u64) -> Vec<f32> {
+    let mut s = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
+    (0..n)
+        .map(|_| {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 23) as f32 - 1.0
+        })
+        .collect()
+}
+
+/// Row-major [m, k] x [k, n] in f64.
+fn reference(a: &[f32], b: &[f32], m: usize, k: usize, n: usize) -> Vec<f64> {
+    let mut c = vec![0.0; m * n];
+    for i in 0..m {
+        for p in 0..k {
+            let x = f64::from(a[i * k + p]);
+            for j in 0..n {
+                c[i * n + j] += x * f64::from(b[p * n + j]);
+            }
+        }
+    }
+    c
+}
+
+fn assert_close(got: &[f32], want: &[f64], what: &str) {
+    assert_eq!(got.len(), want.len(), "{what}: length");
+    for (i, (g, w)) in got.iter().zip(want).enumerate() {
+        assert!((f64::from(*g) - w).abs() <= 1e-4 * (1.0 + w.abs()), "{what}[{i}]: {g} vs {w}");
+    }
+}
+
+#[test]
+fn matrix_products_match_f64_on_both_sides_of_the_alignment_patch() {
+    let d = device::cpu();
+    // Output bytes: 9 x 4 (not a multiple of 16), 4 x 4 x 4 = 64, 513 x 3 x 4, 300 x 128 x 4.
+    for (m, k, n) in [(3, 5, 3), (4, 7, 4), (513, 33, 3), (300, 188, 128), (1, 1, 1)] {
+        for round in 0..3 {
+            let a = values(m * k, (m * 31 + k * 7 + n + round) as u64);
+            let b = values(k * n, (m + k * 13 + n * 3 + round) as u64);
+            let want = reference(&a, &b, m, k, n);
+            let ta = Tensor::<2>::from_data(TensorData::new(a.clone(), [m, k]), &d);
+            let tb = Tensor::<2>::from_data(TensorData::new(b.clone(), [k, n]), &d);
+            let got = ta.clone().matmul(tb.clone()).into_data().try_to_vec::<f32>().unwrap();
+            assert_close(&got, &want, &format!("[{m}, {k}] x [{k}, {n}]"));
+            // The transposed (strided) operand path: (B^T A^T)^T = A B.
+            let t = tb.transpose().matmul(ta.transpose()).transpose();
+            let got = t.into_data().try_to_vec::<f32>().unwrap();
+            assert_close(&got, &want, &format!("transposed [{m}, {k}] x [{k}, {n}]"));
+        }
+    }
+}
+
+#[test]
+fn matrix_product_gradients_match_f64() {
+    let d = device::cpu_training();
+    let (m, k, n) = (37, 12, 8); // 37 x 8 x 4 bytes: a multiple of 16; 37 x 12 x 4 too
+    let a = values(m * k, 1);
+    let b = values(k * n, 2);
+    let ta = Tensor::<2>::from_data(TensorData::new(a.clone(), [m, k]), &d).require_grad();
+    let tb = Tensor::<2>::from_data(TensorData::new(b.clone(), [k, n]), &d).require_grad();
+    // L = sum(A B); dL/dA = 1 B^T (row sums of B), dL/dB = A^T 1 (column sums of A).
+    let grads = ta.clone().matmul(tb.clone()).sum().backward();
+    let ga = ta.grad(&grads).unwrap().into_data().try_to_vec::<f32>().unwrap();
+    let gb = tb.grad(&grads).unwrap().into_data().try_to_vec::<f32>().unwrap();
+    let want_a: Vec<f64> =
+        (0..m * k).map(|i| (0..n).map(|j| f64::from(b[(i % k) * n + j])).sum()).collect();
+    let want_b: Vec<f64> =
+        (0..k * n).map(|i| (0..m).map(|r| f64::from(a[r * k + i / n])).sum()).collect();
+    assert_close(&ga, &want_a, "dL/dA");
+    assert_close(&gb, &want_b, "dL/dB");
+}
+
+#[test]
+fn host_memory_policy_is_active_after_making_a_cpu_device() {
+    let _ = device::cpu();
+    let off = std::env::var(brdf_neural::host_memory::ENV_OFF).is_ok_and(|v| v.trim() == "0");
+    let glibc = cfg!(all(target_os = "linux", target_env = "gnu"));
+    assert_eq!(brdf_neural::host_memory::is_active(), glibc && !off);
+}
