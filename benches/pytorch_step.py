@@ -8,7 +8,7 @@ output (RGB); loss = MSE(f * w, target) with a per-sample weight w (E * shadow *
 backward; Adam (lr 1e-4). Batch 32768 by default. Inputs are random (the angle features'
 computation is not part of the timed step in either implementation).
 
-Usage: python3 benches/pytorch_step.py [--batch 32768] [--threads 2] [--reps 20]
+Usage: python3 benches/pytorch_step.py [--batch 32768] [--threads 2] [--reps 20] [--machine]
 Prints the median and mean step time in ms and samples/s.
 """
 
@@ -49,6 +49,7 @@ def main():
     p.add_argument("--batch", type=int, default=32768)
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--reps", type=int, default=20)
+    p.add_argument("--machine", action="store_true", help="print only 'median_ms <value>'")
     a = p.parse_args()
     torch.set_num_threads(a.threads)
     torch.manual_seed(1)
@@ -73,6 +74,9 @@ def main():
         times.append(time.perf_counter() - t)
     n_params = sum(q.numel() for q in model.parameters())
     med = statistics.median(times)
+    if a.machine:
+        print(f"median_ms {med * 1e3:.3f}")
+        return
     print(
         f"pytorch {torch.__version__} threads {torch.get_num_threads()} batch {a.batch} "
         f"params {n_params}: median {med * 1e3:.1f} ms, mean {statistics.mean(times) * 1e3:.1f} ms, "

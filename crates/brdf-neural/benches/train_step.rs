@@ -117,62 +117,145 @@ impl Step {
     }
 }
 
-/// FP32 matmul rate (GFLOP/s) of [n, 128] x [128, 128] on `device`.
-fn matmul_gflops(device: &Device, n: usize) -> f64 {
-    let a = Tensor::<2>::random([n, 128], Distribution::Uniform(-1.0, 1.0), device);
-    let b = Tensor::<2>::random([128, 128], Distribution::Uniform(-1.0, 1.0), device);
-    let run = || {
-        let c = a.clone().matmul(b.clone());
-        device.sync().expect("sync");
-        drop(c);
+/// The machine's FP32 matrix-multiply rate in GFLOP/s: the `gemm` crate (flex's kernels, all
+/// threads) into preallocated buffers, so allocation and copies are not part of it. Returns
+/// (square 2048 x 2048 x 2048, the step's dominant [n, 128] x [128, 128]); best of 10.
+fn machine_gemm_gflops(n: usize) -> (f64, f64) {
+    let rate = |m: usize, k: usize, p: usize| {
+        let a: Vec<f32> = (0..m * k).map(|i| ((i * 7 % 13) as f32 - 6.0) / 7.0).collect();
+        let b: Vec<f32> = (0..k * p).map(|i| ((i * 5 % 11) as f32 - 5.0) / 6.0).collect();
+        let mut c = vec![0f32; m * p];
+        let mut best = f64::INFINITY;
+        for _ in 0..11 {
+            let t = Instant::now();
+            // SAFETY: row-major buffers of exactly m x k, k x p and m x p elements.
+            unsafe {
+                gemm::gemm(
+                    m,
+                    p,
+                    k,
+                    c.as_mut_ptr(),
+                    1,
+                    p as isize,
+                    false,
+                    a.as_ptr(),
+                    1,
+                    k as isize,
+                    b.as_ptr(),
+                    1,
+                    p as isize,
+                    0.0,
+                    1.0,
+                    false,
+                    false,
+                    false,
+                    gemm::Parallelism::Rayon(0),
+                );
+            }
+            best = best.min(t.elapsed().as_secs_f64());
+        }
+        std::hint::black_box(&c);
+        2.0 * (m * k * p) as f64 / best / 1e9
     };
-    run();
-    let reps = 20;
-    let t = Instant::now();
-    for _ in 0..reps {
-        run();
-    }
-    let secs = t.elapsed().as_secs_f64() / reps as f64;
-    2.0 * n as f64 * 128.0 * 128.0 / secs / 1e9
+    (rate(2048, 2048, 2048), rate(n, 128, 128))
+}
+
+/// Median step time in seconds over `reps` steps.
+fn median_step(step: &mut Step, reps: usize) -> f64 {
+    let mut times: Vec<f64> = (0..reps)
+        .map(|_| {
+            let t = Instant::now();
+            step.run();
+            t.elapsed().as_secs_f64()
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[reps / 2]
+}
+
+/// Median step time (seconds) of `benches/pytorch_step.py` run by `python`, or why not.
+fn pytorch_step(python: &str, n: usize, reps: usize) -> Result<f64, String> {
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../../benches/pytorch_step.py");
+    let threads = rayon_threads().to_string();
+    let out = std::process::Command::new(python)
+        .args([script, "--batch", &n.to_string(), "--threads", &threads])
+        .args(["--reps", &reps.to_string(), "--machine"])
+        .output()
+        .map_err(|e| format!("{python}: {e}"))?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    text.lines()
+        .find_map(|l| l.strip_prefix("median_ms "))
+        .and_then(|v| v.trim().parse::<f64>().ok())
+        .map(|ms| ms / 1e3)
+        .ok_or_else(|| format!("{script}: {}", String::from_utf8_lossy(&out.stderr).trim()))
 }
 
 fn bench(cr: &mut Criterion) {
     let n = batch_size();
+    let quick = std::env::var("BRDF_BENCH_QUICK").is_ok_and(|v| v != "0");
     let mut summary = Vec::new();
+    let mut versus_pytorch = Vec::new();
     for backend in backends() {
         let device = backend.training_device().expect("backend built");
-        let peak = matmul_gflops(&device.clone().inner(), n);
         let mut group = cr.benchmark_group(format!("train_step_{backend:?}").to_lowercase());
         group.sample_size(10).measurement_time(Duration::from_secs(20));
         for (name, c) in configs() {
             let mut step = Step::new(&c, &device, n);
             step.run();
-            group.bench_function(name, |b| b.iter(|| step.run()));
-            // A direct timing for the summary (criterion's estimate is in its report).
-            let reps = 5;
-            let t = Instant::now();
-            for _ in 0..reps {
-                step.run();
+            if !quick {
+                group.bench_function(name, |b| b.iter(|| step.run()));
             }
-            let secs = t.elapsed().as_secs_f64() / reps as f64;
-            summary.push((backend, name, secs, step_flops(&c, n) / secs / 1e9, peak));
+            // A direct timing for the summary (criterion's estimate is in its report).
+            let secs = median_step(&mut step, 7);
+            summary.push((backend, name, secs, step_flops(&c, n) / secs / 1e9));
+            if name == "single_mlp"
+                && let Ok(python) = std::env::var("BRDF_BENCH_PYTORCH")
+            {
+                // Back to back, three rounds: ours then PyTorch's, medians of 10 steps each.
+                // Each side warms up first (PyTorch's script runs 3 untimed steps).
+                for _ in 0..3 {
+                    median_step(&mut step, 3);
+                    let ours = median_step(&mut step, 10);
+                    match pytorch_step(&python, n, 10) {
+                        Ok(theirs) => versus_pytorch.push((backend, ours, theirs)),
+                        Err(e) => {
+                            eprintln!("PyTorch baseline not run: {e}");
+                            break;
+                        }
+                    }
+                }
+            }
         }
         group.finish();
     }
+    let (square, step_shape) = machine_gemm_gflops(n);
     println!(
-        "\nbatch {n}, threads: {} ({:?})",
+        "\nbatch {n}, threads: {} (RAYON_NUM_THREADS {:?}), host-memory policy active: {}",
         rayon_threads(),
-        std::env::var("RAYON_NUM_THREADS").ok()
+        std::env::var("RAYON_NUM_THREADS").ok(),
+        brdf_neural::host_memory::is_active()
     );
-    println!("| backend | model | step ms | samples/s | GFLOP/s | matmul GFLOP/s | fraction |");
-    println!("| --- | --- | ---: | ---: | ---: | ---: | ---: |");
-    for (b, name, secs, gf, peak) in summary {
+    println!(
+        "machine FP32 gemm (gemm crate, preallocated): 2048^3 {square:.1} GFLOP/s, \
+         [{n}, 128] x [128, 128] {step_shape:.1} GFLOP/s"
+    );
+    println!("| backend | model | step ms | samples/s | GFLOP/s | fraction of 2048^3 gemm |");
+    println!("| --- | --- | ---: | ---: | ---: | ---: |");
+    for (b, name, secs, gf) in summary {
         println!(
-            "| {b:?} | {name} | {:.1} | {:.0} | {gf:.1} | {peak:.1} | {:.2} |",
+            "| {b:?} | {name} | {:.1} | {:.0} | {gf:.1} | {:.2} |",
             secs * 1e3,
             n as f64 / secs,
-            gf / peak
+            gf / square
         );
+    }
+    if !versus_pytorch.is_empty() {
+        println!("\nSingle MLP step, back to back with PyTorch (medians of 10 steps):");
+        println!("| backend | ours ms | PyTorch ms | ours / PyTorch |");
+        println!("| --- | ---: | ---: | ---: |");
+        for (b, ours, theirs) in versus_pytorch {
+            println!("| {b:?} | {:.1} | {:.1} | {:.3} |", ours * 1e3, theirs * 1e3, ours / theirs);
+        }
     }
 }
 
