@@ -3,29 +3,37 @@
 //! Disney, with the machine's FP32 matrix-multiply rate measured in the same run.
 //!
 //! `cargo bench -p brdf-neural --bench train_step` (default backend: flex);
-//! `cargo bench -p brdf-neural --features ndarray --bench train_step -- ndarray` for ndarray.
-//! Environment: `BRDF_BENCH_BATCH` (default 32768), `BRDF_BENCH_BACKENDS` (default: every
-//! backend compiled in, e.g. `flex,ndarray`).
+//! `cargo bench -p brdf-neural --features ndarray --bench train_step` adds ndarray.
+//! Environment:
+//! - `BRDF_BENCH_BATCH` (default 32768);
+//! - `BRDF_BENCH_BACKENDS` (default: every CPU backend compiled in, e.g. `flex,ndarray`);
+//! - `BRDF_BENCH_QUICK=1` skips the criterion groups (summary only, about a minute);
+//! - `BRDF_BENCH_PYTORCH=python3` (a Python with torch) also runs `benches/pytorch_step.py`,
+//!   the same Single MLP step in PyTorch on the same number of threads, back to back with
+//!   ours: three rounds of 10 steps each side after warm-up, and prints the ratios;
+//! - `BRDF_KEEP_MALLOC=0` turns the host-memory policy off (`brdf_neural::host_memory`).
 //!
 //! Criterion's filter (e.g. `-- single_mlp`) selects the criterion groups only; the summary
-//! always times every model. After the criterion groups a summary prints samples/s and the achieved GFLOP/s of each step
-//! (matrix-multiply FLOPs of the model: 2 m n k per product, forward 1x and backward 2x),
-//! against the matmul rate of a [32768, 128] x [128, 128] product on the same backend.
+//! always times every model: median step time of 7, samples/s, and the achieved GFLOP/s
+//! (matrix-multiply FLOPs of the model: 2 m n k per product, forward 1x and backward 2x)
+//! against the machine's FP32 gemm rate (the `gemm` crate flex uses, all threads, into
+//! preallocated buffers, best of 11): 2048^3, and the step's dominant [n, 128] x [128, 128].
 //!
-//! Measured (2-core AMD EPYC with AVX-512, burn 0.22.1, `x86-v4` on; the machine was NOT quiet:
-//! load average 4 to 7 from other builds and benches, so absolute figures are 2 to 4 times
-//! slower than on a quiet machine and vary by +-30 % between runs). Step time in ms:
+//! Measured 2026-11-21 on the 2-core AMD EPYC (AVX-512, `x86-v4` on, 2 threads, quiet machine),
+//! burn 0.22.1 with `vendor/burn-flex` and the host-memory policy; machine gemm 206.9 GFLOP/s
+//! (2048^3), 178.4 GFLOP/s ([32768, 128] x [128, 128]). Criterion's step time in ms:
 //!
-//! | model | flex | ndarray | PyTorch 2.15 CPU, 2 threads (same runs) |
+//! | model | flex | GFLOP/s (fraction of gemm) | ndarray |
 //! | --- | ---: | ---: | ---: |
-//! | Single MLP (mapping, 114,691 params) | 540-785 | 1,064-1,137 | 833-2,229 (median of 10 steps, 4 runs) |
-//! | Enh. Add. Shared | 748-1,533 | 1,658-2,667 | |
-//! | Disney | 342-580 | 1,253-1,539 | |
+//! | Single MLP (mapping, 114,691 params) | 164.6 | 137.2 (0.66) | 426.4 |
+//! | Enh. Add. Shared (mapping) | 259.9 | 127.2 (0.61) | 614.3 |
+//! | Disney | 179.9 | 115.6 (0.56) | 433.2 |
 //!
-//! flex beat ndarray by 1.4x to 3.7x in every pair of runs. The Single MLP step time over
-//! PyTorch's, measured back to back, ranged from 0.3 to 1.4 (mostly below 1) as the load
-//! changed: a ratio taken under such load is not a reliable figure. The "matmul GFLOP/s" column is not a peak: under contention the isolated product
-//! runs slower than the products inside a step (fractions above 1).
+//! Back to back with PyTorch 2.15 (MKL, 2 threads) in the same run, Single MLP step, medians
+//! of 10: flex 169.3 / 169.4 / 162.5 ms against PyTorch 212.8 / 214.0 / 220.5 ms, ratios 0.80,
+//! 0.79, 0.74; ndarray 1.75 to 1.89. Without the host-memory policy and the vendored patch
+//! (stock burn-flex 0.22.1, glibc defaults) the same step took 298 to 311 ms against PyTorch's
+//! 225 to 235 ms (ratio 1.3).
 
 use brdf_neural::device::Backend;
 use brdf_neural::mlp::MlpConfig;
