@@ -13,23 +13,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-/// A fresh directory under the system temp dir, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> Self {
-        let p = std::env::temp_dir().join(format!("experiments-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&p);
-        std::fs::create_dir_all(&p).unwrap();
-        Self(p)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+#[path = "../../../test-support/temp_dir.rs"]
+mod temp_dir;
+use temp_dir::TempDir;
 
 /// OBJ of a UV sphere (radius 0.5, centre (0, 0, 0.7)) above the square z = 0.
 fn sphere_over_plane(dir: &Path) -> PathBuf {

@@ -6,18 +6,11 @@
 use experiments::sweep::{self, Execution, SweepProfile};
 use std::path::PathBuf;
 
+#[path = "../../../test-support/shared_data.rs"]
+mod support;
+
 fn shared_data() -> Option<PathBuf> {
-    let dir = std::env::var_os("NEURAL_BRDF_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
-    if dir.is_dir() {
-        return Some(dir);
-    }
-    if std::env::var("CI").is_ok_and(|v| v == "true") {
-        panic!("shared data folder {} is missing (CI=true): set NEURAL_BRDF_DATA", dir.display());
-    }
-    eprintln!("skipping: shared data folder {} not found (set NEURAL_BRDF_DATA)", dir.display());
-    None
+    support::shared_data_root("")
 }
 
 const PROFILE: &str = r#"

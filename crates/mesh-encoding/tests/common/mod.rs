@@ -3,23 +3,14 @@
 
 use std::path::PathBuf;
 
-/// The shared data folder: `$NEURAL_BRDF_DATA`, default `<workspace>/../shared/data`.
-///
-/// Returns `None` (after printing a skip notice) when it is missing, unless `CI=true`, where a
-/// missing folder fails the test.
+#[path = "../../../../test-support/shared_data.rs"]
+mod support;
+
+/// The shared data folder (`$NEURAL_BRDF_DATA`, default `<workspace>/../shared/data`) when
+/// it holds `meshes/`; see `test-support/shared_data.rs`.
 #[allow(dead_code)]
 pub fn data_dir() -> Option<PathBuf> {
-    let dir = std::env::var_os("NEURAL_BRDF_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
-    if dir.join("meshes").is_dir() {
-        return Some(dir);
-    }
-    if std::env::var("CI").is_ok_and(|v| v == "true") {
-        panic!("shared test data not found at {} (set NEURAL_BRDF_DATA)", dir.display());
-    }
-    eprintln!("SKIP: shared test data not found at {} (set NEURAL_BRDF_DATA)", dir.display());
-    None
+    support::shared_data_root("meshes")
 }
 
 /// A fresh, empty temporary directory unique to this process and `name`.
