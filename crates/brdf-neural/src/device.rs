@@ -11,7 +11,7 @@
 //! | `wgpu` | `wgpu` | no | GPU (Vulkan/Metal/DX12 through wgpu); not built in CI |
 //!
 //! The CPU devices made here also tell the C allocator to keep freed tensor buffers for reuse
-//! ([`crate::host_memory`]): 1.7x faster training steps on glibc, measured.
+//! ([`crate::host_memory`]): 1.5 to 1.7x faster training steps on glibc, measured.
 //!
 //! No build requires a CPU feature the machine may lack: flex's matrix products come from the
 //! `gemm` crate, which picks AVX2/FMA kernels at run time; its AVX-512 kernels are compiled only
