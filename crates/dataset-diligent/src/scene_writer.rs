@@ -20,7 +20,7 @@
 use crate::capture::{Capture, diligent_to_opencv};
 use crate::error::{Error, Result};
 use crate::report::ViewReport;
-use dataset_merl::scene::generate::sample_stem;
+use dataset_merl::scene::generate::{image_progress, sample_stem};
 use dataset_merl::scene::manifest::{
     FORMAT, FileEntry, LightInfo, MANIFEST_FILE, Manifest, SceneStats, Split, VERSION, ViewInfo,
 };
@@ -194,18 +194,8 @@ fn assemble(
         .enumerate()
         .flat_map(|(vi, v)| (0..v.lights.len()).map(move |li| (vi, li)))
         .collect();
-    let bar = if progress {
-        indicatif::ProgressBar::new(jobs.len() as u64)
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{msg} [{bar:30}] {pos}/{len} images, {elapsed} elapsed, eta {eta}",
-        )
-        .expect("valid template"),
-    );
-    bar.set_message(format!("importing {} {}", s.benchmark, s.object));
+    let message = format!("importing {} {}", s.benchmark, s.object);
+    let bar = image_progress(jobs.len(), progress, message);
     let stats = Mutex::new(SceneStats::default());
     jobs.par_iter().try_for_each(|&(vi, li)| -> Result<()> {
         let spec = &s.views[vi];

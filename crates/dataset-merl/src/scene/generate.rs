@@ -49,6 +49,24 @@ pub struct GenerateReport {
     pub stats: SceneStats,
 }
 
+/// The progress bar of a scene's image writing (generation here, the DiLiGenT importers'
+/// scene writer): `count` images, hidden unless `visible`.
+pub fn image_progress(count: usize, visible: bool, message: String) -> indicatif::ProgressBar {
+    let bar = if visible {
+        indicatif::ProgressBar::new(count as u64)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{msg} [{bar:30}] {pos}/{len} images, {elapsed} elapsed, eta {eta}",
+        )
+        .expect("valid template"),
+    );
+    bar.set_message(message);
+    bar
+}
+
 /// File stem of (view, light) data.
 pub fn sample_stem(view: usize, light: usize) -> String {
     format!("v{view:02}_l{light:02}")
@@ -179,18 +197,7 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
 
         let jobs: Vec<(usize, usize)> =
             (0..s.views).flat_map(|v| (0..s.lights_per_view).map(move |l| (v, l))).collect();
-        let bar = if progress {
-            indicatif::ProgressBar::new(jobs.len() as u64)
-        } else {
-            indicatif::ProgressBar::hidden()
-        };
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{msg} [{bar:30}] {pos}/{len} images, {elapsed} elapsed, eta {eta}",
-            )
-            .expect("valid template"),
-        );
-        bar.set_message(format!("rendering {}", out.display()));
+        let bar = image_progress(jobs.len(), progress, format!("rendering {}", out.display()));
         let stats = Mutex::new(SceneStats::default());
         jobs.par_iter().try_for_each(|&(vi, li)| -> Result<()> {
             let vp = &geometry.views[vi];
