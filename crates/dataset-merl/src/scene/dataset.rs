@@ -157,6 +157,21 @@ impl SceneDataset {
         Ok(px)
     }
 
+    /// The noise-free render of a test (view, light) pair, clipped like the observation:
+    /// `None` when the scene has none (captured data, or a training pair).
+    pub fn clean_image(&self, view: usize, light: usize) -> Result<Option<Vec<[f32; 3]>>> {
+        let rel = format!("clean/{}.exr", sample_stem(view, light));
+        if !self.manifest.files.iter().any(|f| f.path == rel) {
+            return Ok(None);
+        }
+        self.read_exr("clean", view, light).map(Some)
+    }
+
+    /// Whether the scene carries noise-free renders of its test pairs (semi-synthetic scenes).
+    pub fn has_clean_renders(&self) -> bool {
+        self.manifest.files.iter().any(|f| f.path.starts_with("clean/"))
+    }
+
     /// The flags image of (view, light).
     pub fn flags_image(&self, view: usize, light: usize) -> Result<Vec<u8>> {
         let path = self.dir.join(format!("flags/{}.png", sample_stem(view, light)));

@@ -9,6 +9,7 @@
 //! | `mesh.ply` | the cleaned mesh normalised into the unit sphere, binary PLY |
 //! | `masks/vVV.png` | object mask of view VV, 8-bit (255 = object) |
 //! | `images/vVV_lLL.exr` | observed linear HDR radiance, RGB float |
+//! | `clean/vVV_lLL.exr` | test pairs only: the noise-free radiance, clipped like the observation (the noise ceiling's "perfect model") |
 //! | `brdf/vVV_lLL.exr` | ground-truth BRDF (1/sr) where lit and valid, else 0 |
 //! | `flags/vVV_lLL.png` | per-pixel [`flag`](super::render::flag) bits (lit, shadowed, back-facing, GT valid, saturated) |
 //! | `previews/vVV.png` | sRGB preview of view VV under its first light, for looking at |
@@ -173,7 +174,7 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
     let is_train = train_views(s.views, s.train_views, config.seed);
 
     // Assemble under a temporary name beside the target.
-    let subdirs = ["images", "brdf", "flags", "masks", "previews"];
+    let subdirs = ["images", "clean", "brdf", "flags", "masks", "previews"];
     let manifest = crate::atomic::write_dir_atomic(out, &subdirs, |tmp: &Path| -> Result<_> {
         let settings = PrecomputeSettings {
             shadow_bias: ShadowBias::Relative(s.shadow_bias_relative),
@@ -207,11 +208,17 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
                 seed: config.seed
                     ^ ((vi as u64) << 32 | li as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15),
             };
-            let img = render_light(vp, li, s.light_intensity, gt.as_ref(), sensor);
+            let direction = views[vi].lights[li].to_array();
+            let img = render_light(vp, li, direction, s.light_intensity, gt.as_ref(), sensor);
             let (w, h) = (vp.width as usize, vp.height as usize);
             let stem = sample_stem(vi, li);
-            let mut entries = Vec::with_capacity(4);
-            for (dir, data) in [("images", &img.observed), ("brdf", &img.brdf)] {
+            let mut entries = Vec::with_capacity(5);
+            let test_pair = !is_train[vi] && li >= s.train_lights;
+            let mut exrs = vec![("images", &img.observed), ("brdf", &img.brdf)];
+            if test_pair {
+                exrs.push(("clean", &img.clean));
+            }
+            for (dir, data) in exrs {
                 let rel = format!("{dir}/{stem}.exr");
                 let bytes = images::write_exr_rgb(&tmp.join(&rel), w, h, data)?;
                 entries.push(FileEntry::of(rel, &bytes));

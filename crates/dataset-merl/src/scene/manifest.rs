@@ -12,8 +12,9 @@ use std::path::Path;
 
 /// Format name in every manifest.
 pub const FORMAT: &str = "neural-brdf-scene";
-/// Current format version.
-pub const VERSION: u32 = 1;
+/// Current format version. 2: semi-synthetic scenes carry the noise-free test renders
+/// (`clean/`), and their radiance is formed in f32 by `render::shade`.
+pub const VERSION: u32 = 2;
 /// The manifest's file name inside a scene directory.
 pub const MANIFEST_FILE: &str = "manifest.json";
 
@@ -167,7 +168,13 @@ impl Manifest {
             return Err(fault(format!("format `{}`, expected `{FORMAT}`", m.format)));
         }
         if m.version != VERSION {
-            return Err(fault(format!("format version {}, this build reads {VERSION}", m.version)));
+            return Err(fault(format!(
+                "format version {}, this build reads {VERSION} (version 2 added the noise-free \
+                 test renders the noise ceiling needs): regenerate the scene (`cargo xtask \
+                 generate-scenes`; `reproduce-tables` does it by itself) or re-import the \
+                 capture (`cargo xtask import-diligent`)",
+                m.version
+            )));
         }
         if m.checksum != m.body_checksum() {
             return Err(fault("checksum mismatch: the manifest was edited or damaged".into()));

@@ -3,6 +3,11 @@
 //!
 //! Only lit samples evaluate the BRDF: background pixels are not traced, and shadowed or
 //! back-facing samples carry no information about it.
+//!
+//! The radiance is formed in f32 by [`shade`] from the f32 BRDF value that is stored in the
+//! scene, the f32 shading normal and light direction: the same function, on the same values,
+//! that training and evaluation use. A model that returns the stored ground-truth BRDF
+//! therefore renders the scene's noise-free image bit for bit (its noise ceiling is exact).
 
 use raycast_precompute::{LightState, ViewPrecompute};
 
@@ -23,10 +28,29 @@ pub mod flag {
 /// The ground-truth BRDF: local-frame (l, v) to RGB in 1/sr, `None` where invalid.
 pub type GroundTruth<'a> = dyn Fn([f64; 3], [f64; 3]) -> Option<[f64; 3]> + Sync + 'a;
 
+/// E cos(theta_l) per channel for a unit shading normal `n` and light direction `l` (world
+/// space, f32), `None` when cos(theta_l) is not positive: the factor a BRDF value is
+/// multiplied by to render a directional light (spec 6).
+pub fn light_weight(irradiance: [f32; 3], n: [f32; 3], l: [f32; 3]) -> Option<[f32; 3]> {
+    let cos = n[0] * l[0] + n[1] * l[1] + n[2] * l[2];
+    if cos.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return None;
+    }
+    Some([irradiance[0] * cos, irradiance[1] * cos, irradiance[2] * cos])
+}
+
+/// The radiance L = f E cos(theta_l) of a BRDF value `f` under a light of weight `w`
+/// ([`light_weight`]).
+pub fn shade(f: [f32; 3], w: [f32; 3]) -> [f32; 3] {
+    [f[0] * w[0], f[1] * w[1], f[2] * w[2]]
+}
+
 /// One rendered (view, light) image, full frame, row-major.
 pub struct LightImage {
     /// Observed linear radiance (noise and saturation applied).
     pub observed: Vec<[f32; 3]>,
+    /// The noise-free radiance, clipped at the saturation level like the observation.
+    pub clean: Vec<[f32; 3]>,
     /// Ground-truth BRDF (1/sr) where lit and valid, else 0.
     pub brdf: Vec<[f32; 3]>,
     /// [`flag`] bits per pixel (0 for background).
@@ -67,12 +91,15 @@ impl Normal {
     }
 }
 
-/// Renders light `light` of a view.
+/// Renders light `light` of a view. `direction` is the light's direction as the scene's
+/// manifest records it (what training and evaluation shade with; the precompute holds a
+/// renormalised copy, which may differ in the last bit).
 // Channel loops index several per-channel arrays at once.
 #[allow(clippy::needless_range_loop)]
 pub fn render_light(
     view: &ViewPrecompute,
     light: usize,
+    direction: [f32; 3],
     intensity: [f32; 3],
     gt: &GroundTruth<'_>,
     sensor: Sensor,
@@ -80,6 +107,7 @@ pub fn render_light(
     let n_pix = (view.width * view.height) as usize;
     let mut img = LightImage {
         observed: vec![[0.0; 3]; n_pix],
+        clean: vec![[0.0; 3]; n_pix],
         brdf: vec![[0.0; 3]; n_pix],
         flags: vec![0; n_pix],
     };
@@ -91,14 +119,15 @@ pub fn render_light(
         let frame = angles::Frame::from_normal([n.x as f64, n.y as f64, n.z as f64]);
         let to_local = |w: glam::Vec3| frame.to_local([w.x as f64, w.y as f64, w.z as f64]);
         let (l, v) = (to_local(l_world), to_local(view.view_dirs[k]));
-        let mut radiance = [0.0_f64; 3];
+        let mut radiance = [0.0_f32; 3];
         let mut flags = match view.visibility.get(k, light) {
             LightState::Lit if l[2] > 0.0 && v[2] > 0.0 => {
                 match gt(l, v) {
                     Some(f) => {
-                        for c in 0..3 {
-                            radiance[c] = f[c] * intensity[c] as f64 * l[2];
-                            img.brdf[p][c] = f[c] as f32;
+                        let f = f.map(|x| x as f32);
+                        img.brdf[p] = f;
+                        if let Some(w) = light_weight(intensity, n.to_array(), direction) {
+                            radiance = shade(f, w);
                         }
                         flag::LIT | flag::GT_VALID
                     }
@@ -110,12 +139,13 @@ pub fn render_light(
         };
         let mut saturated = false;
         for c in 0..3 {
-            let x = radiance[c] + sensor.noise_sigma as f64 * noise.sample();
+            let x = radiance[c] as f64 + sensor.noise_sigma as f64 * noise.sample();
             let x = x as f32;
             if x >= sensor.saturation {
                 saturated = true;
             }
             img.observed[p][c] = x.min(sensor.saturation);
+            img.clean[p][c] = radiance[c].min(sensor.saturation);
         }
         if saturated {
             flags |= flag::SATURATED;
