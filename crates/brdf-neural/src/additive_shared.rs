@@ -48,6 +48,11 @@ impl AdditiveShared {
         Self { trunk, diffuse, specular, head }
     }
 
+    /// How the raw outputs become f_d, f_s and xi.
+    pub(crate) fn head(&self) -> &AdditiveHead {
+        &self.head
+    }
+
     /// Evaluates the model.
     ///
     /// # Shapes

@@ -76,6 +76,7 @@ pub mod host_memory;
 pub mod mlp;
 pub mod model;
 pub mod output;
+pub mod output_init;
 pub mod parametric;
 pub mod single_mlp;
 pub mod tensor_brdf;

@@ -153,6 +153,24 @@ pub struct Mlp {
 }
 
 impl Mlp {
+    /// The same MLP with the bias of its last linear layer set to `bias` (one value per
+    /// output), the parameter keeping its id and gradient setting.
+    ///
+    /// # Panics
+    /// If `bias.len()` is not the last layer's output width, or the layer has no bias.
+    pub fn with_output_bias(mut self, bias: &[f32]) -> Self {
+        let last = self.layers.pop().expect("an MLP has a layer");
+        let param = last.bias.clone().expect("output layer with a bias");
+        assert_eq!(param.val().dims(), [bias.len()], "output bias width");
+        let data = burn::tensor::TensorData::new(bias.to_vec(), [bias.len()]);
+        let param = param.map(|t| {
+            let fresh = Tensor::<1>::from_data(data, &t.device());
+            if t.is_require_grad() { fresh.require_grad() } else { fresh }
+        });
+        self.layers.push(Linear { bias: Some(param), ..last });
+        self
+    }
+
     /// Applies the MLP.
     ///
     /// # Arguments

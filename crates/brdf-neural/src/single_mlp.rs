@@ -38,6 +38,11 @@ impl SingleMlp {
         Self { mlp, output_scale }
     }
 
+    /// The factor on the output softplus.
+    pub fn scale(&self) -> f32 {
+        self.output_scale
+    }
+
     /// Evaluates the model.
     ///
     /// # Shapes
