@@ -28,6 +28,15 @@ pub struct CheckpointState {
     pub curve: Vec<CurveRow>,
     /// Training wall time so far, seconds.
     pub seconds: f64,
+    /// The plateau rule's state.
+    #[serde(default)]
+    pub plateau: crate::plateau::Plateau,
+    /// Snapshots kept so far.
+    #[serde(default)]
+    pub snapshots: Vec<crate::run_dir::Snapshot>,
+    /// Set once training has stopped early (the checkpoint of the last step).
+    #[serde(default)]
+    pub stopped: Option<crate::plateau::StopReason>,
 }
 
 /// Folder of the checkpoint after `step` steps.

@@ -10,8 +10,14 @@ use crate::config::{FeatureConfig, SpatialKind};
 use crate::loss::srgb_oetf;
 use crate::{Error, Result};
 use angles::Frame;
+use dataset_merl::scene::Split;
+use dataset_merl::scene::render::light_weight;
 use dataset_merl::{SampleSet, SceneDataset};
 use mesh_encoding::{EigenSettings, LboEncoding, cached_eigenpairs};
+use rand::SeedableRng;
+use rand::rngs::StdRng;
+use rand::seq::SliceRandom;
+use std::collections::HashSet;
 use std::path::Path;
 
 /// Samples ready for batching, struct of arrays.
@@ -33,6 +39,9 @@ pub struct TrainingData {
     pub observed_gamma: Vec<[f32; 3]>,
     /// Index of each record in the source [`SampleSet`].
     pub source: Vec<usize>,
+    /// The sensor's clip level of the scene (semi-synthetic scenes; see
+    /// [`crate::eval::images::clip_level`]): renders are compared after clipping there.
+    pub clip: Option<f32>,
 }
 
 /// A gathered batch on the CPU.
@@ -64,19 +73,28 @@ impl TrainingData {
     /// Builds the records from `samples` with per-sample spatial features `spatial`
     /// (`[samples.len(), spatial_dim]`).
     pub fn new(samples: &SampleSet, spatial: &[f32], spatial_dim: usize) -> Self {
+        Self::from_indices(samples, spatial, spatial_dim, 0..samples.len())
+    }
+
+    /// Builds the records of the samples at `indices` (into `samples` and the rows of
+    /// `spatial`), in that order.
+    pub fn from_indices(
+        samples: &SampleSet,
+        spatial: &[f32],
+        spatial_dim: usize,
+        indices: impl IntoIterator<Item = usize>,
+    ) -> Self {
         let mut d = TrainingData { spatial_dim, ..Default::default() };
-        for i in 0..samples.len() {
+        for i in indices {
             let n = samples.normal[i];
             let (lw, vw) = (samples.l[i], samples.v[i]);
-            let cos = n[0] * lw[0] + n[1] * lw[1] + n[2] * lw[2];
-            if cos.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-                continue;
-            }
+            // The generator's own weight (bit for bit), so that the ground truth renders the
+            // scene's noise-free images exactly.
+            let Some(weight) = light_weight(samples.irradiance[i], n, lw) else { continue };
             let frame = Frame::from_normal(n);
             d.l.push(frame.to_local(lw));
             d.v.push(frame.to_local(vw));
-            let e = samples.irradiance[i];
-            d.weight.push([e[0] * cos, e[1] * cos, e[2] * cos]);
+            d.weight.push(weight);
             let o = samples.observed[i];
             d.observed.push(o);
             d.observed_gamma.push(o.map(srgb_oetf));
@@ -84,6 +102,21 @@ impl TrainingData {
             d.source.push(i);
         }
         d
+    }
+
+    /// The least-squares constant BRDF of the records, per channel: the f minimising
+    /// sum (f E cos - L_obs)^2, i.e. sum(L_obs E cos) / sum((E cos)^2), clamped to >= 0
+    /// (zero without records). What `output_init = "data"` starts the models at.
+    pub fn mean_brdf(&self) -> [f32; 3] {
+        let mut num = [0.0_f64; 3];
+        let mut den = [0.0_f64; 3];
+        for (o, w) in self.observed.iter().zip(&self.weight) {
+            for c in 0..3 {
+                num[c] += o[c] as f64 * w[c] as f64;
+                den[c] += w[c] as f64 * w[c] as f64;
+            }
+        }
+        std::array::from_fn(|c| if den[c] > 0.0 { (num[c] / den[c]).max(0.0) as f32 } else { 0.0 })
     }
 
     /// The gamma-MSE of predicting f = 0 everywhere: mean of gamma(L_obs)^2.
@@ -112,6 +145,58 @@ impl TrainingData {
         }
         b
     }
+}
+
+/// The (view, light) pairs held out for validation: in every view, `fraction` of its training
+/// lights (at least one when the view has two or more), evenly spaced through the view's
+/// training lights in manifest order, the last one included. Test lights are never chosen.
+pub fn validation_pairs(scene: &SceneDataset, fraction: f64) -> HashSet<(u16, u16)> {
+    let mut out = HashSet::new();
+    if fraction <= 0.0 {
+        return out;
+    }
+    for (vi, view) in scene.manifest.views.iter().enumerate() {
+        if view.split != Split::Train {
+            continue;
+        }
+        let train: Vec<usize> =
+            (0..view.lights.len()).filter(|&li| view.lights[li].split == Split::Train).collect();
+        let m = train.len();
+        if m < 2 {
+            continue;
+        }
+        let k = ((m as f64 * fraction).round() as usize).clamp(1, m - 1);
+        for i in 0..k {
+            out.insert((vi as u16, train[(i + 1) * m / k - 1] as u16));
+        }
+    }
+    out
+}
+
+/// Splits the training samples into training and validation indices: the samples of the
+/// validation pairs ([`validation_pairs`]) go to validation, of which at most `cap` are kept
+/// (a subset drawn with `seed`), in sample order.
+pub fn split_validation(
+    samples: &SampleSet,
+    pairs: &HashSet<(u16, u16)>,
+    cap: usize,
+    seed: u64,
+) -> (Vec<usize>, Vec<usize>) {
+    let (mut train, mut val) = (Vec::new(), Vec::new());
+    for i in 0..samples.len() {
+        if pairs.contains(&(samples.view[i], samples.light[i])) {
+            val.push(i);
+        } else {
+            train.push(i);
+        }
+    }
+    if val.len() > cap {
+        let mut rng = StdRng::seed_from_u64(seed ^ 0x7A11_DA7E_5EED_0001);
+        val.shuffle(&mut rng);
+        val.truncate(cap);
+        val.sort_unstable();
+    }
+    (train, val)
 }
 
 /// Spatial features of every sample of `samples`, `[n, dim]` row-major, and `dim`.

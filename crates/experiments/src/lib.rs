@@ -3,7 +3,10 @@
 //! * [`config`]: the run configuration (TOML), profiles and validation.
 //! * [`data`]: the lit training records (spatial features, local directions, E cos) and batches.
 //! * [`loss`]: the sRGB-gamma MSE and the enhanced split's regularisers.
-//! * [`train`]: [`fit`], the training loop with checkpoints, resume and non-finite detection.
+//! * [`train_config`], [`plateau`]: the `[train]` table (optimiser, schedule, validation
+//!   split) and the plateau rule that decays the rate and stops a converged run.
+//! * [`train`], [`trainer`]: [`fit`] and its loop: validation, checkpoints, snapshots, resume
+//!   and non-finite detection.
 //! * [`checkpoint`], [`run_dir`]: what a run directory holds, written atomically.
 //! * [`eval`]: test renders, maps and every metric of a finished run.
 //! * [`export`]: a fitted model as a MERL-format table at one surface point.
@@ -23,8 +26,9 @@
 //! two runs give bit-identical loss curves and that a run interrupted and resumed equals an
 //! uninterrupted one (Adam's moments are checkpointed).
 //!
-//! Learning rate, schedule and iteration counts are the project's decisions (the paper gives
-//! none); see [`config`] for the profiles' defaults.
+//! Learning rate, schedule, initialisation and stopping are the project's decisions (the paper
+//! gives none); see [`train_config`] for the profiles' defaults and `docs/reproduce.md` for the
+//! measurements behind them.
 
 pub mod checkpoint;
 pub mod config;
@@ -34,10 +38,13 @@ mod error;
 pub mod eval;
 pub mod export;
 pub mod loss;
+pub mod plateau;
 pub mod report;
 pub mod run_dir;
 pub mod sweep;
 pub mod train;
+pub mod train_config;
+pub mod trainer;
 
 pub use config::{RunConfig, TrainConfig};
 pub use error::{Error, Result};

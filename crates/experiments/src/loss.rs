@@ -3,9 +3,10 @@
 //!
 //! gamma(c) = 12.92 c for c <= 0.0031308, else 1.055 c^(1/2.4) - 0.055, applied to
 //! max(c, 0) and NOT clamped above 1 (the formula extends past 1, so highlights keep their
-//! gradient).
+//! gradient). The rendering is clipped at the sensor's saturation level first (semi-synthetic
+//! scenes clip their observations there; evaluation clips renders the same way).
 //!
-//! L = mean_{batch, RGB} (gamma(f E cos) - gamma(L_obs))^2
+//! L = mean_{batch, RGB} (gamma(min(f E cos, clip)) - gamma(L_obs))^2
 //!   + w_d mean |gamma(f_d E cos) - gamma(L_obs)| + w_s mean |f_s|   (enhanced models only)
 
 use brdf_neural::BrdfOutput;
@@ -35,13 +36,17 @@ pub fn srgb_oetf_tensor(x: Tensor<2>) -> Tensor<2> {
     power.mask_where(mask, linear)
 }
 
-/// Weights of the loss terms.
+/// Weights of the loss terms, and the sensor's clip level.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LossWeights {
     /// Enhanced split: weight of the diffuse regulariser.
     pub diffuse: f64,
     /// Enhanced split: weight of the specular regulariser.
     pub specular: f64,
+    /// The rendering is clipped here before the comparison, like the sensor clipped the
+    /// observation (semi-synthetic scenes; `None` for captures): a saturated observation is a
+    /// lower bound, and a prediction above the clip is not penalised.
+    pub clip: Option<f32>,
 }
 
 /// The loss of one batch.
@@ -61,13 +66,17 @@ pub fn loss(
     regularise: bool,
     w: LossWeights,
 ) -> Tensor<1> {
-    let pred = srgb_oetf_tensor(out.f.clone() * weight.clone());
+    let clipped = |x: Tensor<2>| match w.clip {
+        Some(c) => x.clamp_max(c),
+        None => x,
+    };
+    let pred = srgb_oetf_tensor(clipped(out.f.clone() * weight.clone()));
     let mut total = (pred - target_gamma.clone()).square().mean();
     if regularise {
         if let Some(fd) = &out.diffuse
             && w.diffuse > 0.0
         {
-            let d = srgb_oetf_tensor(fd.clone() * weight) - target_gamma;
+            let d = srgb_oetf_tensor(clipped(fd.clone() * weight)) - target_gamma;
             total = total + d.abs().mean().mul_scalar(w.diffuse);
         }
         if let Some(fs) = &out.specular

@@ -1,0 +1,253 @@
+//! The training loop of [`crate::fit`]: optimiser steps, validation losses, the plateau rule,
+//! the curve, snapshots and checkpoints.
+//!
+//! The loop's inputs that never change (configuration, records, devices, run directory,
+//! progress bar) live in [`Loop`]; what changes (model, optimiser, [`CheckpointState`]) is
+//! passed through it explicitly, so every step is a function of (state, step) and a resumed
+//! run repeats an uninterrupted one exactly.
+
+use crate::checkpoint::{self, CheckpointState};
+use crate::config::RunConfig;
+use crate::data::TrainingData;
+use crate::diagnose::{all_finite, diagnose};
+use crate::loss::{LossWeights, loss, srgb_oetf};
+use crate::plateau::{Decision, StopReason};
+use crate::run_dir::{CURVE_FILE, CurveRow, Snapshot, snapshot_path, temp_path, write_curve};
+use crate::{Error, Result};
+use brdf_neural::{BrdfModel, Reciprocity, Samples};
+use burn::module::Module;
+use burn::optim::{GradientsParams, ModuleOptimizer};
+use burn::tensor::{Device, Tensor, TensorData};
+use indicatif::ProgressBar;
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// A callback run before each step with the step index and the model (tests use it to inject
+/// faults).
+pub type StepHook = Box<dyn FnMut(u64, BrdfModel) -> BrdfModel>;
+
+/// How the loop ended.
+pub(crate) enum LoopEnd {
+    /// Training is over (plateau or budget); the state says which.
+    Done(BrdfModel, CheckpointState),
+    /// Interrupted on request after this many steps (a checkpoint was written).
+    Interrupted(u64),
+}
+
+/// The unchanging inputs of the loop.
+pub(crate) struct Loop<'a> {
+    /// The run's configuration.
+    pub config: &'a RunConfig,
+    /// The run directory.
+    pub run: &'a Path,
+    /// Training records.
+    pub data: &'a TrainingData,
+    /// Validation records (empty without a validation split).
+    pub val: &'a TrainingData,
+    /// The training (autodiff) device.
+    pub device: Device,
+    /// The progress bar (hidden when not shown).
+    pub bar: ProgressBar,
+}
+
+/// The batch generator of `step`: a function of (seed, step) only.
+fn step_rng(seed: u64, step: u64) -> StdRng {
+    StdRng::seed_from_u64(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ step)
+}
+
+/// Uploads a flattened `[rows, 3]` buffer.
+fn tensor(values: Vec<f32>, rows: usize, device: &Device) -> Tensor<2> {
+    Tensor::from_data(TensorData::new(values, [rows, 3]), device)
+}
+
+impl Loop<'_> {
+    /// Trains from `state` until the plateau rule or the budget stops it, or until
+    /// `stop_after` steps (then checkpointed and reported as interrupted).
+    pub fn run(
+        &self,
+        mut model: BrdfModel,
+        optim: &mut ModuleOptimizer,
+        mut state: CheckpointState,
+        mut last_checkpoint: Option<PathBuf>,
+        mut hook: Option<StepHook>,
+        stop_after: Option<u64>,
+    ) -> Result<LoopEnd> {
+        let t = &self.config.train;
+        let (start, seconds_before) = (Instant::now(), state.seconds);
+        let mut window = (Instant::now(), state.step);
+        while state.step < t.iterations && state.stopped.is_none() {
+            let step = state.step;
+            if let Some(h) = hook.as_mut() {
+                model = h(step, model);
+            }
+            let lr = t.lr_at(step) * state.plateau.lr_scale;
+            let value;
+            (model, value) = self.step(model, optim, step, lr, &last_checkpoint)?;
+            state.step += 1;
+            let val_loss = self.maybe_validate(&model, &mut state)?;
+            let seconds = seconds_before + start.elapsed().as_secs_f64();
+            if state.step.is_multiple_of(t.log_every) || val_loss.is_some() {
+                state.curve.push(CurveRow { step: state.step, loss: value, val_loss, lr, seconds });
+                self.report(&state, value, &mut window);
+            }
+            self.bar.set_position(state.step);
+            if t.snapshots && t.snapshot_steps().contains(&state.step) {
+                self.save_snapshot(&model, state.step)?;
+                state.snapshots.push(Snapshot { step: state.step, seconds });
+            }
+            if state.step >= t.iterations && state.stopped.is_none() {
+                state.stopped = Some(StopReason::Budget);
+            }
+            let interrupted = stop_after.is_some_and(|s| state.step >= s);
+            if state.step.is_multiple_of(t.checkpoint_every)
+                || interrupted
+                || state.stopped.is_some()
+            {
+                state.seconds = seconds;
+                last_checkpoint = Some(self.checkpoint(&model, optim, &state, value)?);
+            }
+            if interrupted && state.stopped.is_none() {
+                self.bar.abandon();
+                return Ok(LoopEnd::Interrupted(state.step));
+            }
+        }
+        Ok(LoopEnd::Done(model, state))
+    }
+
+    /// One optimiser step at rate `lr`: the batch of `step`, the loss, its gradient, Adam.
+    fn step(
+        &self,
+        model: BrdfModel,
+        optim: &mut ModuleOptimizer,
+        step: u64,
+        lr: f64,
+        last_checkpoint: &Option<PathBuf>,
+    ) -> Result<(BrdfModel, f32)> {
+        let (t, c) = (&self.config.train, &self.config.model);
+        let bs = t.batch_size;
+        let mut rng = step_rng(self.config.seed, step);
+        let n = self.data.len();
+        let indices: Vec<usize> = (0..bs).map(|_| rng.random_range(0..n)).collect();
+        let cpu = self.data.gather(&indices);
+        let swap = c.angles.reciprocity == Reciprocity::RandomSwap;
+        let mask = swap.then(|| c.angles.swap_mask(bs, &mut rng));
+        let samples = Samples { spatial: &cpu.spatial, l: &cpu.l, v: &cpu.v };
+        let batch = c.batch(&samples, mask.as_deref(), &self.device)?;
+        let weight = tensor(cpu.weight, bs, &self.device);
+        let target = tensor(cpu.target_gamma, bs, &self.device);
+        let out = model.forward(&batch);
+        let weights = LossWeights {
+            diffuse: t.diffuse_reg_weight,
+            specular: t.specular_reg_weight,
+            clip: self.data.clip,
+        };
+        let total = loss(&out, weight, target, c.kind.is_enhanced(), weights);
+        let value: f32 = total.clone().into_scalar::<f32>();
+        if !value.is_finite() {
+            self.bar.abandon();
+            return Err(Error::NonFinite {
+                step,
+                loss: value,
+                diagnosis: diagnose(&model),
+                checkpoint: last_checkpoint.clone(),
+            });
+        }
+        let grads = GradientsParams::from_grads(total.backward(), &model);
+        Ok((optim.step(lr, model, grads), value))
+    }
+
+    /// After every `validate_every` steps: the validation loss, fed to the plateau rule (which
+    /// may decay the rate or mark the run stopped).
+    fn maybe_validate(
+        &self,
+        model: &BrdfModel,
+        state: &mut CheckpointState,
+    ) -> Result<Option<f32>> {
+        let t = &self.config.train;
+        if self.val.is_empty() || !state.step.is_multiple_of(t.validate_every) {
+            return Ok(None);
+        }
+        let v = validation_loss(model, self.config, self.val)?;
+        match state.plateau.update(state.step, v, t) {
+            Decision::Stop => state.stopped = Some(StopReason::Plateau),
+            Decision::Decayed | Decision::Continue => {}
+        }
+        Ok(Some(v as f32))
+    }
+
+    /// Progress message: losses, rate and throughput since the last report.
+    fn report(&self, state: &CheckpointState, loss: f32, window: &mut (Instant, u64)) {
+        let (t0, s0) = *window;
+        let samples = (state.step - s0) as f64 * self.config.train.batch_size as f64;
+        let rate = samples / t0.elapsed().as_secs_f64().max(1e-9);
+        let best = state.plateau.best.map_or(String::new(), |b| format!("  val {b:.3e}"));
+        let lr = self.config.train.learning_rate * state.plateau.lr_scale;
+        self.bar.set_message(format!("loss {loss:.3e}{best}  lr {lr:.1e}  {rate:.0} samples/s"));
+        *window = (Instant::now(), state.step);
+    }
+
+    /// Writes the weights after `step` steps to the snapshot folder.
+    fn save_snapshot(&self, model: &BrdfModel, step: u64) -> Result<()> {
+        let path = snapshot_path(self.run, step);
+        save_weights(model, &path)
+    }
+
+    /// Checks the weights, writes a checkpoint and the curve.
+    fn checkpoint(
+        &self,
+        model: &BrdfModel,
+        optim: &ModuleOptimizer,
+        state: &CheckpointState,
+        loss: f32,
+    ) -> Result<PathBuf> {
+        if !all_finite(model) {
+            self.bar.abandon();
+            return Err(Error::NonFinite {
+                step: state.step.saturating_sub(1),
+                loss,
+                diagnosis: diagnose(model),
+                checkpoint: checkpoint::latest(self.run)?,
+            });
+        }
+        let dir = checkpoint::save(self.run, model, optim, state)?;
+        write_curve(&self.run.join(CURVE_FILE), &state.curve)?;
+        Ok(dir)
+    }
+}
+
+/// The gamma-MSE of `model` on the records `val` (no regularisers), computed in inference
+/// mode on the CPU device.
+pub fn validation_loss(model: &BrdfModel, config: &RunConfig, val: &TrainingData) -> Result<f64> {
+    let device = brdf_neural::device::cpu();
+    let pred = crate::eval::predict(&model.valid(), &config.model, val, &device, false)?;
+    Ok(gamma_mse(val, &pred.f))
+}
+
+/// The gamma-MSE of the BRDF values `f` (one per record) on the records, renders clipped like
+/// the observations: the training loss without regularisers.
+pub fn gamma_mse(records: &TrainingData, f: &[[f32; 3]]) -> f64 {
+    let mut sum = 0.0_f64;
+    let clip = records.clip.unwrap_or(f32::INFINITY);
+    for ((f, w), g) in f.iter().zip(&records.weight).zip(&records.observed_gamma) {
+        for c in 0..3 {
+            let d = srgb_oetf((f[c] * w[c]).min(clip)) - g[c];
+            sum += d as f64 * d as f64;
+        }
+    }
+    sum / (3 * records.len().max(1)) as f64
+}
+
+/// Writes weights atomically (a temporary sibling with the same extension, then rename).
+pub fn save_weights(model: &BrdfModel, path: &Path) -> Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    }
+    let tmp = temp_path(path);
+    model
+        .clone()
+        .save_file(&tmp)
+        .map_err(|e| Error::format(&tmp, format!("cannot write weights: {e:?}")))?;
+    std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
+}
