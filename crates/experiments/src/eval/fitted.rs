@@ -44,6 +44,16 @@ impl FittedRun {
         Ok(Self { config, device, model, dataset, cache })
     }
 
+    /// Another weight file of the same configuration (a snapshot) on the run's device.
+    pub fn load_weights_file(&self, path: &Path) -> Result<BrdfModel> {
+        use burn::module::Module;
+        self.config
+            .model
+            .init(&self.device)?
+            .try_load_file(path)
+            .map_err(|e| Error::format(path, format!("cannot load weights: {e:?}")))
+    }
+
     /// The lit test samples and their training records (features, local directions).
     pub fn test_records(&self) -> Result<(SampleSet, TrainingData)> {
         let samples = self.dataset.samples(Split::Test)?;

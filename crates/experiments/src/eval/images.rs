@@ -1,13 +1,25 @@
-//! The test images of a run: renders, image metrics, FLIP error maps and the additive models'
-//! split figures.
+//! The test images of a run: renders, image metrics against the observed and the noise-free
+//! images, the noise ceiling, FLIP error maps and the additive models' split figures.
 //!
 //! For every test (view, light) pair the rendering L = f E cos(theta_l) is formed at the lit
 //! foreground pixels (shadowed and back-facing pixels render 0, like the ground truth: the
-//! renderer has no interreflections) and scored against the observed image on the object mask
-//! (the view's foreground pixels): PSNR and DSSIM on sRGB clamped to [0, 1], HDR-FLIP on linear
-//! values, and LPIPS (when its weights are present) on the sRGB images with the background set
-//! to black in both (LPIPS has no mask argument; blacking the background out is the masked
-//! equivalent). Written into the run directory when images are on:
+//! renderer has no interreflections) by the scene's own [`shade`], clipped at the scene's
+//! saturation level for semi-synthetic scenes (the sensor clips every observation there), and
+//! scored on the object mask (the view's foreground pixels): PSNR and DSSIM on sRGB clamped to
+//! [0, 1], HDR-FLIP on linear values, and LPIPS (when its weights are present) on the sRGB
+//! images with the background set to black in both (LPIPS has no mask argument; blacking the
+//! background out is the masked equivalent).
+//!
+//! Semi-synthetic scenes also hold the noise-free render of every test pair. The model is then
+//! scored against it too ([`ImageScores::clean`]), and the noise-free render itself is scored
+//! against the observation: the noise ceiling, the best any model can score
+//! ([`ImageScores::ceiling`]). A model that returns the ground-truth BRDF renders the
+//! noise-free image exactly, so it scores the ceiling against the observations and infinite
+//! PSNR against the noise-free images. HDR-FLIP takes its exposure range from the observed
+//! image in all three comparisons of a test image (a noise-free image can be all black in the
+//! mask, where FLIP's range is undefined).
+//!
+//! Written into the run directory when images are on:
 //!
 //! ```text
 //! renders/view007_light003.{exr,png}        the model's rendering (linear EXR, sRGB PNG)
@@ -24,24 +36,62 @@ use crate::run_dir::write_atomic;
 use crate::{Error, Result};
 use dataset_merl::scene::Split;
 use dataset_merl::scene::images::{write_exr_rgb, write_png_srgb};
+use dataset_merl::scene::render::shade;
 use dataset_merl::{SampleSet, SceneDataset};
 use indicatif::{ProgressBar, ProgressStyle};
 use metrics::Image;
 use metrics::lpips::Lpips;
+use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-/// Mean image metrics over the test images.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct ImageScores {
-    /// Mean PSNR (dB).
+/// Mean image metrics over the test images, raw (not table-scaled).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ImageMetrics {
+    /// Mean PSNR (dB, sRGB clamped, object mask); +inf for identical images.
+    #[serde(with = "super::serde_inf")]
     pub psnr: f64,
     /// Mean DSSIM.
     pub dssim: f64,
     /// Mean HDR-FLIP.
     pub flip: f64,
-    /// Mean LPIPS, when the weights were present.
+    /// Mean LPIPS, when its weights were present.
+    #[serde(default)]
     pub lpips: Option<f64>,
+}
+
+impl ImageMetrics {
+    fn add(&mut self, o: &ImageMetrics) {
+        self.psnr += o.psnr;
+        self.dssim += o.dssim;
+        self.flip += o.flip;
+        self.lpips = match (self.lpips, o.lpips) {
+            (Some(a), Some(b)) => Some(a + b),
+            (None, Some(b)) => Some(b),
+            (a, None) => a,
+        };
+    }
+
+    fn divided(mut self, n: usize) -> Self {
+        let n = n.max(1) as f64;
+        self.psnr /= n;
+        self.dssim /= n;
+        self.flip /= n;
+        self.lpips = self.lpips.map(|l| l / n);
+        self
+    }
+}
+
+/// The mean metrics of a run's test images.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ImageScores {
+    /// The model against the observed (noisy) test images.
+    pub model: ImageMetrics,
+    /// The model against the noise-free test images (semi-synthetic scenes).
+    pub clean: Option<ImageMetrics>,
+    /// The noise ceiling: the noise-free images against the observed ones (semi-synthetic
+    /// scenes).
+    pub ceiling: Option<ImageMetrics>,
     /// Test images scored.
     pub images: usize,
 }
@@ -57,125 +107,288 @@ pub fn write_png_rgb8(path: &Path, width: usize, height: usize, rgb: &[[u8; 3]])
     write_atomic(path, &bytes)
 }
 
-fn flat(v: &[[f32; 3]]) -> Vec<f32> {
-    v.iter().flat_map(|c| c.iter().copied()).collect()
+fn to_image(w: usize, h: usize, v: &[[f32; 3]]) -> Result<Image> {
+    Ok(Image::new(w, h, v.iter().flat_map(|c| c.iter().copied()).collect())?)
 }
 
-fn mul(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [a[0] * b[0], a[1] * b[1], a[2] * b[2]]
-}
-
-/// Renders every test pair, writes the images (when `write`) and returns the mean metrics.
-/// `lpips`: the loaded network, or `None` (weights missing).
-#[allow(clippy::too_many_arguments)]
-pub fn render_and_score(
-    dataset: &SceneDataset,
-    samples: &SampleSet,
-    data: &TrainingData,
-    pred: &Prediction,
-    run: &Path,
-    write: bool,
+/// Scores `test` against `reference` on `mask`; returns the metrics and the HDR-FLIP result.
+/// `exposures` fixes FLIP's (start, stop) exposures; `None` derives them from the reference.
+pub fn score(
+    test: &Image,
+    reference: &Image,
+    mask: &[bool],
     lpips: Option<&Lpips>,
-    progress: bool,
-) -> Result<ImageScores> {
-    let s = &dataset.manifest.config.settings;
-    let (w, h) = (s.width as usize, s.height as usize);
-    let pairs = dataset.pairs(Split::Test);
-    let (renders, flips, albedo_dir) = (run.join("renders"), run.join("flip"), run.join("albedo"));
-    if write {
-        for d in [&renders, &flips, &albedo_dir] {
-            std::fs::create_dir_all(d).map_err(|e| Error::io(d, e))?;
-        }
-    }
-    let mut by_pair: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
-    for (r, &i) in data.source.iter().enumerate() {
-        by_pair.entry((samples.view[i] as usize, samples.light[i] as usize)).or_default().push(r);
-    }
-    let bar = if progress { ProgressBar::new(pairs.len() as u64) } else { ProgressBar::hidden() };
-    bar.set_style(
-        ProgressStyle::with_template("eval {bar:40} {pos}/{len} test images, eta {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    let mut m = ImageScores::default();
-    let mut lpips_sum = 0.0;
-    // Per view: sum of pi f_d and the count, for the albedo maps.
-    let mut albedo: HashMap<usize, (Vec<[f32; 3]>, Vec<u32>)> = HashMap::new();
-    for &(vi, li) in &pairs {
-        let records = by_pair.get(&(vi, li)).map(Vec::as_slice).unwrap_or_default();
-        let render = |part: &[[f32; 3]]| {
-            let mut img = vec![[0.0_f32; 3]; w * h];
-            for &r in records {
-                img[samples.pixel[data.source[r]] as usize] = mul(part[r], data.weight[r]);
-            }
-            img
-        };
-        let img = render(&pred.f);
-        let mut mask = vec![false; w * h];
-        for &p in &dataset.geometry.views[vi].pixels {
-            mask[p as usize] = true;
-        }
-        let gt = dataset.observed_image(vi, li)?;
-        let test = Image::new(w, h, flat(&img))?;
-        let reference = Image::new(w, h, flat(&gt))?;
-        m.psnr += metrics::psnr_linear(&test, &reference, Some(&mask))?;
-        m.dssim += metrics::dssim_linear(&test, &reference, Some(&mask))?;
-        let flip = metrics::hdr_flip_with(&test, &reference, Some(&mask), &Default::default())?;
-        m.flip += flip.mean;
-        if let Some(net) = lpips {
+    exposures: Option<(f64, f64)>,
+) -> Result<(ImageMetrics, metrics::flip::FlipResult)> {
+    let config = metrics::flip::FlipConfig {
+        start_exposure: exposures.map(|e| e.0),
+        stop_exposure: exposures.map(|e| e.1),
+        ..Default::default()
+    };
+    let flip = metrics::hdr_flip_with(test, reference, Some(mask), &config)?;
+    let lpips = match lpips {
+        Some(net) => {
             let masked = |im: &Image| {
                 let srgb = metrics::srgb::to_srgb_clamped(im);
                 let d: Vec<f32> = srgb
                     .data()
                     .chunks_exact(3)
-                    .zip(&mask)
+                    .zip(mask)
                     .flat_map(|(c, &inside)| if inside { [c[0], c[1], c[2]] } else { [0.0; 3] })
                     .collect();
-                Image::new(w, h, d)
+                Image::new(im.width(), im.height(), d)
             };
-            lpips_sum += net.distance(&masked(&test)?, &masked(&reference)?)?;
+            Some(net.distance(&masked(test)?, &masked(reference)?)?)
         }
-        m.images += 1;
-        if write {
+        None => None,
+    };
+    let m = ImageMetrics {
+        psnr: metrics::psnr_linear(test, reference, Some(mask))?,
+        dssim: metrics::dssim_linear(test, reference, Some(mask))?,
+        flip: flip.mean,
+        lpips,
+    };
+    Ok((m, flip))
+}
+
+/// What [`render_and_score`] needs besides the scene and the prediction.
+pub struct RenderOptions<'a> {
+    /// The run directory (images are written below it).
+    pub run: &'a Path,
+    /// Write the images.
+    pub write: bool,
+    /// The LPIPS network, or `None` (weights missing).
+    pub lpips: Option<&'a Lpips>,
+    /// Show a progress bar.
+    pub progress: bool,
+}
+
+/// The clip level renders get: the saturation of semi-synthetic scenes, none for captures
+/// (whose observations are raw values divided by a per-light intensity).
+pub fn clip_level(dataset: &SceneDataset) -> Option<f32> {
+    use dataset_merl::scene::MaterialSpec;
+    let c = &dataset.manifest.config;
+    (!matches!(c.material, MaterialSpec::Captured { .. })).then_some(c.settings.saturation)
+}
+
+/// Renders every test pair, writes the images (when `opts.write`) and returns the mean metrics.
+pub fn render_and_score(
+    dataset: &SceneDataset,
+    samples: &SampleSet,
+    data: &TrainingData,
+    pred: &Prediction,
+    opts: &RenderOptions<'_>,
+) -> Result<ImageScores> {
+    let t = TestImages::new(dataset, samples, data);
+    let (w, h) = (t.width, t.height);
+    let out = OutputDirs::new(opts.run, opts.write)?;
+    let bar = progress_bar(t.pairs.len(), opts.progress);
+    let (mut model, mut clean, mut ceiling) = (ImageMetrics::default(), None, None);
+    let mut albedo = AlbedoMaps::default();
+    for &(vi, li) in &t.pairs {
+        let records = t.records(vi, li);
+        let render = |part: &[[f32; 3]]| t.render(records, part);
+        let img = render(&pred.f);
+        let mask = t.mask(vi);
+        let test = to_image(w, h, &img)?;
+        let observed = to_image(w, h, &dataset.observed_image(vi, li)?)?;
+        let (m, flip) = score(&test, &observed, &mask, opts.lpips, None)?;
+        model.add(&m);
+        if let Some(noise_free) = dataset.clean_image(vi, li)? {
+            // The three scores of a test image share the observed image's FLIP exposures (a
+            // noise-free image can be black where every lit pixel faces away).
+            let exposures = Some((flip.start_exposure, flip.stop_exposure));
+            let noise_free = to_image(w, h, &noise_free)?;
+            let (c, _) = score(&test, &noise_free, &mask, opts.lpips, exposures)?;
+            clean.get_or_insert_with(ImageMetrics::default).add(&c);
+            let (g, _) = score(&noise_free, &observed, &mask, opts.lpips, exposures)?;
+            ceiling.get_or_insert_with(ImageMetrics::default).add(&g);
+        }
+        if let Some(out) = &out {
             let stem = format!("view{vi:03}_light{li:03}");
-            write_exr_rgb(&renders.join(format!("{stem}.exr")), w, h, &img)?;
-            write_png_srgb(&renders.join(format!("{stem}.png")), w as u32, h as u32, &img)?;
-            let map = metrics::colormap::error_map_rgb8(&flip.map, Some(&mask));
-            write_png_rgb8(&flips.join(format!("{stem}.png")), w, h, &map)?;
+            out.write_pair(&stem, (w, h), &img, &flip.map, &mask)?;
             for (name, part) in [("diffuse", &pred.diffuse), ("specular", &pred.specular)] {
                 if let Some(part) = part {
-                    let path = renders.join(format!("{stem}_{name}.png"));
+                    let path = out.renders.join(format!("{stem}_{name}.png"));
                     write_png_srgb(&path, w as u32, h as u32, &render(part))?;
                 }
             }
             if let Some(fd) = &pred.diffuse_raw {
-                let (sum, count) =
-                    albedo.entry(vi).or_insert_with(|| (vec![[0.0; 3]; w * h], vec![0; w * h]));
-                for &r in records {
-                    let p = samples.pixel[data.source[r]] as usize;
-                    for c in 0..3 {
-                        sum[p][c] += std::f32::consts::PI * fd[r][c];
-                    }
-                    count[p] += 1;
-                }
+                albedo.add(
+                    vi,
+                    w * h,
+                    records.iter().map(|&r| (samples.pixel[data.source[r]], fd[r])),
+                );
             }
         }
         bar.inc(1);
     }
     bar.finish_and_clear();
-    let mut views: Vec<_> = albedo.into_iter().collect();
-    views.sort_by_key(|(vi, _)| *vi);
-    for (vi, (sum, count)) in views {
-        let mean: Vec<[f32; 3]> = sum
-            .iter()
-            .zip(&count)
-            .map(|(s, &n)| if n > 0 { s.map(|x| x / n as f32) } else { [0.0; 3] })
-            .collect();
-        write_png_srgb(&albedo_dir.join(format!("view{vi:03}.png")), w as u32, h as u32, &mean)?;
+    if let Some(out) = &out {
+        albedo.write(&out.albedo, (w, h))?;
     }
-    let n = m.images.max(1) as f64;
-    m.psnr /= n;
-    m.dssim /= n;
-    m.flip /= n;
-    m.lpips = lpips.map(|_| lpips_sum / n);
-    Ok(m)
+    let n = t.pairs.len();
+    Ok(ImageScores {
+        model: model.divided(n),
+        clean: clean.map(|c| c.divided(n)),
+        ceiling: ceiling.map(|c| c.divided(n)),
+        images: n,
+    })
+}
+
+/// The mean PSNR of the renders of `f` (one BRDF value per record of `data`) against the
+/// observed test images: the cheap score of the run-time curve's snapshots.
+pub fn mean_psnr(
+    dataset: &SceneDataset,
+    samples: &SampleSet,
+    data: &TrainingData,
+    f: &[[f32; 3]],
+) -> Result<f64> {
+    let t = TestImages::new(dataset, samples, data);
+    let mut sum = 0.0;
+    for &(vi, li) in &t.pairs {
+        let test = to_image(t.width, t.height, &t.render(t.records(vi, li), f))?;
+        let observed = to_image(t.width, t.height, &dataset.observed_image(vi, li)?)?;
+        sum += metrics::psnr_linear(&test, &observed, Some(&t.mask(vi)))?;
+    }
+    Ok(sum / t.pairs.len().max(1) as f64)
+}
+
+/// The test pairs of a scene and their records, for rendering.
+struct TestImages<'a> {
+    dataset: &'a SceneDataset,
+    samples: &'a SampleSet,
+    data: &'a TrainingData,
+    width: usize,
+    height: usize,
+    pairs: Vec<(usize, usize)>,
+    by_pair: HashMap<(usize, usize), Vec<usize>>,
+    clip: Option<f32>,
+}
+
+impl<'a> TestImages<'a> {
+    fn new(dataset: &'a SceneDataset, samples: &'a SampleSet, data: &'a TrainingData) -> Self {
+        let s = &dataset.manifest.config.settings;
+        let mut by_pair: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
+        for (r, &i) in data.source.iter().enumerate() {
+            let key = (samples.view[i] as usize, samples.light[i] as usize);
+            by_pair.entry(key).or_default().push(r);
+        }
+        TestImages {
+            dataset,
+            samples,
+            data,
+            width: s.width as usize,
+            height: s.height as usize,
+            pairs: dataset.pairs(Split::Test),
+            by_pair,
+            clip: clip_level(dataset),
+        }
+    }
+
+    /// The records of a test pair.
+    fn records(&self, vi: usize, li: usize) -> &[usize] {
+        self.by_pair.get(&(vi, li)).map(Vec::as_slice).unwrap_or_default()
+    }
+
+    /// The object mask of a view.
+    fn mask(&self, vi: usize) -> Vec<bool> {
+        let mut mask = vec![false; self.width * self.height];
+        for &p in &self.dataset.geometry.views[vi].pixels {
+            mask[p as usize] = true;
+        }
+        mask
+    }
+
+    /// The image of `part` (one value per record of the data) at `records`, clipped.
+    fn render(&self, records: &[usize], part: &[[f32; 3]]) -> Vec<[f32; 3]> {
+        let mut img = vec![[0.0_f32; 3]; self.width * self.height];
+        for &r in records {
+            let l = shade(part[r], self.data.weight[r]);
+            let p = self.samples.pixel[self.data.source[r]] as usize;
+            img[p] = self.clip.map_or(l, |c| l.map(|x| x.min(c)));
+        }
+        img
+    }
+}
+
+fn progress_bar(len: usize, visible: bool) -> ProgressBar {
+    let bar = if visible { ProgressBar::new(len as u64) } else { ProgressBar::hidden() };
+    bar.set_style(
+        ProgressStyle::with_template("eval {bar:40} {pos}/{len} test images, eta {eta}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+/// The image folders of a run.
+struct OutputDirs {
+    renders: PathBuf,
+    flips: PathBuf,
+    albedo: PathBuf,
+}
+
+impl OutputDirs {
+    /// Creates the folders; `None` when images are not written.
+    fn new(run: &Path, write: bool) -> Result<Option<Self>> {
+        if !write {
+            return Ok(None);
+        }
+        let d = OutputDirs {
+            renders: run.join("renders"),
+            flips: run.join("flip"),
+            albedo: run.join("albedo"),
+        };
+        for dir in [&d.renders, &d.flips, &d.albedo] {
+            std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+        }
+        Ok(Some(d))
+    }
+
+    /// The render (EXR and sRGB PNG) and the FLIP map of one test pair.
+    fn write_pair(
+        &self,
+        stem: &str,
+        (w, h): (usize, usize),
+        img: &[[f32; 3]],
+        flip_map: &[f32],
+        mask: &[bool],
+    ) -> Result<()> {
+        write_exr_rgb(&self.renders.join(format!("{stem}.exr")), w, h, img)?;
+        write_png_srgb(&self.renders.join(format!("{stem}.png")), w as u32, h as u32, img)?;
+        let map = metrics::colormap::error_map_rgb8(flip_map, Some(mask));
+        write_png_rgb8(&self.flips.join(format!("{stem}.png")), w, h, &map)
+    }
+}
+
+/// Per view: the sum of pi f_d and the sample count per pixel, for the albedo maps.
+#[derive(Default)]
+struct AlbedoMaps(HashMap<usize, (Vec<[f32; 3]>, Vec<u32>)>);
+
+impl AlbedoMaps {
+    fn add(&mut self, view: usize, pixels: usize, values: impl Iterator<Item = (u32, [f32; 3])>) {
+        let (sum, count) =
+            self.0.entry(view).or_insert_with(|| (vec![[0.0; 3]; pixels], vec![0; pixels]));
+        for (p, fd) in values {
+            let p = p as usize;
+            for c in 0..3 {
+                sum[p][c] += std::f32::consts::PI * fd[c];
+            }
+            count[p] += 1;
+        }
+    }
+
+    fn write(self, dir: &Path, (w, h): (usize, usize)) -> Result<()> {
+        let mut views: Vec<_> = self.0.into_iter().collect();
+        views.sort_by_key(|(vi, _)| *vi);
+        for (vi, (sum, count)) in views {
+            let mean: Vec<[f32; 3]> = sum
+                .iter()
+                .zip(&count)
+                .map(|(s, &n)| if n > 0 { s.map(|x| x / n as f32) } else { [0.0; 3] })
+                .collect();
+            write_png_srgb(&dir.join(format!("view{vi:03}.png")), w as u32, h as u32, &mean)?;
+        }
+        Ok(())
+    }
 }

@@ -17,19 +17,37 @@ pub mod analyses;
 pub mod fitted;
 pub mod images;
 pub mod predict;
+mod serde_inf;
 pub mod settings;
 
 pub use analyses::EnergySummary;
 pub use fitted::FittedRun;
+pub use images::ImageMetrics;
 pub use predict::{ModelBrdf, Prediction, predict};
 pub use settings::{EnergyEstimator, EvalConfig, EvalSettings};
 
 use crate::Result;
-use crate::run_dir::{METRICS_FILE, RunMetrics};
+use crate::data::TrainingData;
+use crate::run_dir::{METRICS_FILE, RunMetrics, Snapshot, snapshot_path};
+use dataset_merl::SampleSet;
 use metrics::rmse::{CubeRootRmse, RmseConfig};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::time::Instant;
+
+/// One point of a run's run-time curve: the test scores of a weight snapshot.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CurvePoint {
+    /// Training steps of the snapshot.
+    pub step: u64,
+    /// Wall time of the run at that step, seconds.
+    pub seconds: f64,
+    /// Mean test PSNR (dB) against the observed images.
+    pub psnr: f64,
+    /// Cube-root RMSE of the BRDF (absent without ground truth).
+    #[serde(default)]
+    pub rmse_cbrt: Option<f64>,
+}
 
 /// Test metrics of a run (spec 7), raw values (not table-scaled).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -40,6 +58,13 @@ pub struct TestMetrics {
     pub dssim: f64,
     /// Mean HDR-FLIP over the test images.
     pub flip: f64,
+    /// The model against the noise-free test renders (semi-synthetic scenes only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clean: Option<ImageMetrics>,
+    /// The noise ceiling: the noise-free test renders scored against the observed ones, the
+    /// best any model can score (semi-synthetic scenes only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ceiling: Option<ImageMetrics>,
     /// Mean LPIPS over the test images (absent without weights).
     #[serde(default)]
     pub lpips: Option<f64>,
@@ -59,6 +84,9 @@ pub struct TestMetrics {
     /// Energy conservation.
     #[serde(default)]
     pub energy: Option<EnergySummary>,
+    /// Test scores of the weight snapshots, in step order (runs with `train.snapshots`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub curve: Vec<CurvePoint>,
     /// Wall-clock seconds of the whole evaluation.
     #[serde(default)]
     pub seconds: f64,
@@ -88,6 +116,43 @@ pub fn energy_of_run(
     analyses::energy(&brdf, &settings, config.seed, progress)
 }
 
+/// The cube-root RMSE of the predictions `f` (one per record of `data`) over the samples with
+/// a valid ground truth, and the number of samples kept.
+pub fn cube_root_rmse(
+    samples: &SampleSet,
+    data: &TrainingData,
+    f: &[[f32; 3]],
+) -> Result<(Option<f64>, usize)> {
+    let mut rmse = CubeRootRmse::new(RmseConfig::default());
+    for (r, &i) in data.source.iter().enumerate() {
+        // Samples without a valid ground truth (invalid MERL bins, captured data) are left out.
+        if samples.gt_valid[i] {
+            let (lz, vz) = (data.l[r][2], data.v[r][2]);
+            rmse.push(f[r], samples.gt_brdf[i], lz, vz, samples.saturated[i]);
+        }
+    }
+    let value = if rmse.kept > 0 { Some(rmse.value()?) } else { None };
+    Ok((value, rmse.kept))
+}
+
+/// Test PSNR and cube-root RMSE of every weight snapshot of the run.
+fn snapshot_curve(
+    fitted: &FittedRun,
+    run: &Path,
+    snapshots: &[Snapshot],
+    (samples, data): (&SampleSet, &TrainingData),
+) -> Result<Vec<CurvePoint>> {
+    let mut out = Vec::with_capacity(snapshots.len());
+    for s in snapshots {
+        let model = fitted.load_weights_file(&snapshot_path(run, s.step))?;
+        let pred = predict(&model, &fitted.config.model, data, &fitted.device, false)?;
+        let psnr = images::mean_psnr(&fitted.dataset, samples, data, &pred.f)?;
+        let (rmse_cbrt, _) = cube_root_rmse(samples, data, &pred.f)?;
+        out.push(CurvePoint { step: s.step, seconds: s.seconds, psnr, rmse_cbrt });
+    }
+    Ok(out)
+}
+
 /// Evaluates the finished run in `run`; `scene` overrides the config's scene directory.
 pub fn eval(
     run: &Path,
@@ -103,50 +168,38 @@ pub fn eval(
     let (samples, data) = fitted.test_records()?;
     let parts = config.model.kind.is_additive() && settings.images;
     let pred = predict(model, &config.model, &data, device, parts)?;
-
-    let mut rmse = CubeRootRmse::new(RmseConfig::default());
-    for (r, &i) in data.source.iter().enumerate() {
-        // Samples without a valid ground truth (invalid MERL bins, captured data) are left out.
-        if samples.gt_valid[i] {
-            let (lz, vz) = (data.l[r][2], data.v[r][2]);
-            rmse.push(pred.f[r], samples.gt_brdf[i], lz, vz, samples.saturated[i]);
-        }
-    }
-    let rmse_cbrt = if rmse.kept > 0 { Some(rmse.value()?) } else { None };
+    let (rmse_cbrt, rmse_samples) = cube_root_rmse(&samples, &data, &pred.f)?;
 
     let (lpips, lpips_unavailable) = if settings.lpips_weights.is_file() {
         (Some(metrics::lpips::Lpips::load(&settings.lpips_weights, device)?), None)
     } else {
         (None, Some("weights missing".to_string()))
     };
-    let scores = images::render_and_score(
-        dataset,
-        &samples,
-        &data,
-        &pred,
-        run,
-        settings.images,
-        lpips.as_ref(),
-        progress,
-    )?;
+    let opts =
+        images::RenderOptions { run, write: settings.images, lpips: lpips.as_ref(), progress };
+    let scores = images::render_and_score(dataset, &samples, &data, &pred, &opts)?;
     let brdf = ModelBrdf { model, config: &config.model, data: &data, device };
     let reciprocity_rmse = analyses::reciprocity(&brdf, &settings)?;
     let energy = analyses::energy(&brdf, &settings, config.seed, progress)?;
+    let path = run.join(METRICS_FILE);
+    let mut all = RunMetrics::read(&path)?;
+    let curve = snapshot_curve(&fitted, run, &all.snapshots, (&samples, &data))?;
     let test = TestMetrics {
-        psnr: scores.psnr,
-        dssim: scores.dssim,
-        flip: scores.flip,
-        lpips: scores.lpips,
+        psnr: scores.model.psnr,
+        dssim: scores.model.dssim,
+        flip: scores.model.flip,
+        clean: scores.clean,
+        ceiling: scores.ceiling,
+        lpips: scores.model.lpips,
         lpips_unavailable,
         rmse_cbrt,
-        rmse_samples: rmse.kept,
+        rmse_samples,
         images: scores.images,
         reciprocity_rmse,
         energy,
+        curve,
         seconds: start.elapsed().as_secs_f64(),
     };
-    let path = run.join(METRICS_FILE);
-    let mut all = RunMetrics::read(&path)?;
     all.test = Some(test.clone());
     all.write(&path)?;
     Ok(test)

@@ -1,0 +1,74 @@
+//! The noise ceiling on the smoke profile's scene (the shipped Spot mesh, blue-acrylic, 32 px,
+//! 4 views x 12 lights): a "model" that returns the exact ground-truth BRDF scores the ceiling
+//! (the noise-free renders against the observations) to 1e-6 dB on every metric, and +inf dB
+//! against the noise-free renders; a model off by a few percent scores below the ceiling.
+
+use dataset_merl::SceneDataset;
+use dataset_merl::scene::{MaterialSpec, SceneConfig, SceneSettings, Split};
+use experiments::data::TrainingData;
+use experiments::eval::Prediction;
+use experiments::eval::images::{RenderOptions, render_and_score};
+
+#[path = "../../../test-support/temp_dir.rs"]
+mod temp_dir;
+use temp_dir::TempDir;
+
+fn smoke_scene(dir: &std::path::Path) -> SceneDataset {
+    let config = SceneConfig {
+        mesh: experiments::sweep::profile::resolve_mesh("embedded:spot", dir).unwrap(),
+        material: MaterialSpec::Merl { name: "blue-acrylic".into() },
+        seed: 1,
+        settings: SceneSettings::with_counts(32, 4, 12),
+        merl_dir: None,
+    };
+    let out = dir.join("scene");
+    dataset_merl::generate_scene(&config, &out, false).unwrap();
+    SceneDataset::open(&out).unwrap()
+}
+
+#[test]
+fn the_ground_truth_scores_the_noise_ceiling_exactly() {
+    let dir = TempDir::new("ceiling");
+    let scene = smoke_scene(&dir.0);
+    assert!(scene.has_clean_renders());
+    let samples = scene.samples(Split::Test).unwrap();
+    let data = TrainingData::new(&samples, &[], 0);
+    assert!(!data.is_empty());
+    let gt: Vec<[f32; 3]> = data.source.iter().map(|&i| samples.gt_brdf[i]).collect();
+    let opts = RenderOptions { run: &dir.0, write: false, lpips: None, progress: false };
+    let score = |f: Vec<[f32; 3]>| {
+        let pred = Prediction { f, ..Default::default() };
+        render_and_score(&scene, &samples, &data, &pred, &opts).unwrap()
+    };
+    let perfect = score(gt.clone());
+    let ceiling = perfect.ceiling.clone().expect("a semi-synthetic scene has a ceiling");
+    assert!(perfect.images > 0);
+    assert!((perfect.model.psnr - ceiling.psnr).abs() < 1e-6, "{perfect:?}");
+    assert!((perfect.model.dssim - ceiling.dssim).abs() < 1e-12, "{perfect:?}");
+    assert!((perfect.model.flip - ceiling.flip).abs() < 1e-12, "{perfect:?}");
+    let clean = perfect.clean.clone().unwrap();
+    assert_eq!(clean.psnr, f64::INFINITY, "{perfect:?}");
+    assert_eq!((clean.dssim, clean.flip), (0.0, 0.0), "{perfect:?}");
+    // The noise (sigma 1e-3) is what bounds the ceiling: finite, and high.
+    assert!(ceiling.psnr.is_finite() && ceiling.psnr > 35.0, "{ceiling:?}");
+    // A model 3 % too bright is below the ceiling against the observations and finite
+    // against the noise-free renders.
+    let off = score(gt.iter().map(|f| f.map(|x| 1.03 * x)).collect());
+    assert!(off.model.psnr < ceiling.psnr - 0.1, "{off:?} vs {ceiling:?}");
+    assert!(off.clean.unwrap().psnr.is_finite());
+    assert_eq!(off.ceiling.unwrap(), ceiling, "the ceiling does not depend on the model");
+}
+
+#[test]
+fn scenes_of_the_old_format_ask_to_be_regenerated() {
+    let dir = TempDir::new("old-scene");
+    let scene = smoke_scene(&dir.0);
+    // Rewrite the manifest as version 1 (checksum recomputed: a valid old manifest).
+    let mut m = scene.manifest.clone();
+    m.version = 1;
+    let path = scene.dir.join(dataset_merl::scene::manifest::MANIFEST_FILE);
+    std::fs::write(&path, m.to_json()).unwrap();
+    let err = SceneDataset::open(&scene.dir).err().expect("version 1 is refused").to_string();
+    assert!(err.contains("version 1") && err.contains("regenerate"), "{err}");
+    assert!(err.contains("manifest.json"), "{err}");
+}
