@@ -1,7 +1,8 @@
 //! A whole sweep end to end on a miniature profile (Spot from the shared data at 24 px, three
-//! models, the NOL ablation and a two-point run-time curve): scenes, LBO tables, runs, eval and
-//! every table and figure; a second sweep finds every run finished (content addressing);
-//! `--emit-jobs` writes one command per unfinished run.
+//! models, the NOL ablation and the run-time curve of their snapshots): scenes, LBO tables,
+//! runs, eval and every table and figure, with the noise ceiling and the note on unconverged
+//! runs; a second sweep finds every run finished (content addressing); `--emit-jobs` writes
+//! one command per unfinished run.
 
 use experiments::sweep::{self, Execution, SweepProfile};
 use std::path::PathBuf;
@@ -37,13 +38,15 @@ batch_size = 512
 warmup_steps = 2
 checkpoint_every = 6
 log_every = 3
+validate_every = 3
+patience = 6
 [run.eval]
 energy_pairs = 4
 reciprocity_pairs = 200
 [sweep]
 models = ["single_mlp", "disney", "additive_shared_enhanced"]
 ablations = ["nol"]
-runtime_budgets = [6, 12]
+runtime_curve = true
 "#;
 
 #[test]
@@ -54,18 +57,31 @@ fn a_miniature_sweep_produces_every_table_and_resumes() {
     let profile = SweepProfile::parse(PROFILE, "mini.toml").unwrap();
     let s = sweep::sweep(&profile, &out, &data, &Execution::InProcess).unwrap();
     assert!(s.failed.is_empty(), "{:?}", s.failed);
-    // 3 Table 1 runs + 2 NOL (single MLP, enhanced shared) + 3 x 2 budgets, one of which (12
-    // steps) is the Table 1 run itself.
-    assert_eq!(s.runs.len(), 3 + 2 + 3);
-    assert_eq!((s.completed, s.skipped, s.scenes_generated), (8, 0, 1));
+    // 3 Table 1 runs (with snapshots: the run-time curve) + 2 NOL (single MLP, enhanced
+    // shared).
+    assert_eq!(s.runs.len(), 3 + 2);
+    assert_eq!((s.completed, s.skipped, s.scenes_generated), (5, 0, 1));
     let c = sweep::collect(&[out.join("runs")], &out, "mini").unwrap();
-    assert_eq!(c.runs, 8);
+    assert_eq!(c.runs, 5);
     let t1 = std::fs::read_to_string(out.join("tables/table1.md")).unwrap();
-    for name in ["Single MLP", "Disney", "Enh. Add. Shared", "MERL-derived (NBRDF)", "mini"] {
+    for name in [
+        "Single MLP",
+        "Disney",
+        "Enh. Add. Shared",
+        "MERL-derived (NBRDF)",
+        "mini",
+        "Ground truth (noise ceiling)",
+        "below ceiling",
+        "Not converged: 3 of 3 runs",
+    ] {
         assert!(t1.contains(name), "{name} missing from\n{t1}");
     }
+    let runtime = std::fs::read_to_string(out.join("tables/runtime.md")).unwrap();
+    assert!(runtime.contains("s to -0.5 dB") && runtime.contains("Single MLP"), "{runtime}");
     for f in [
         "tables/table1.tex",
+        "tables/table1-noise-free.md",
+        "tables/runtime.tex",
         "tables/nol.md",
         "tables/energy.md",
         "tables/reciprocity.md",
@@ -79,16 +95,16 @@ fn a_miniature_sweep_produces_every_table_and_resumes() {
     }
     // Everything is finished: a second sweep runs nothing.
     let again = sweep::sweep(&profile, &out, &data, &Execution::InProcess).unwrap();
-    assert_eq!((again.completed, again.skipped, again.scenes_kept), (0, 8, 1));
+    assert_eq!((again.completed, again.skipped, again.scenes_kept), (0, 5, 1));
     // A changed configuration is a new run; --emit-jobs lists exactly the unfinished one.
     let changed =
         SweepProfile::parse(&PROFILE.replace("seed = 1", "seed = 2"), "mini2.toml").unwrap();
     let jobs = out.join("jobs.txt");
     let how = Execution::Emit { file: jobs.clone(), command: vec!["run-one".into()] };
     let e = sweep::sweep(&changed, &out, &data, &how).unwrap();
-    assert_eq!(e.emitted, 8);
+    assert_eq!(e.emitted, 5);
     let text = std::fs::read_to_string(&jobs).unwrap();
-    assert_eq!(text.lines().count(), 8);
+    assert_eq!(text.lines().count(), 5);
     assert!(text.lines().all(|l| l.starts_with("run-one /")), "{text}");
     let _ = std::fs::remove_dir_all(&out);
 }
@@ -103,9 +119,9 @@ fn the_smoke_profile_runs_end_to_end() {
     let s =
         sweep::sweep(&profile, &out, std::path::Path::new("data"), &Execution::InProcess).unwrap();
     assert!(s.failed.is_empty(), "{:?}", s.failed);
-    assert_eq!((s.runs.len(), s.completed), (92, 92));
+    assert_eq!((s.runs.len(), s.completed), (74, 74));
     let c = sweep::collect(&[out.join("runs")], &out, "smoke").unwrap();
-    assert_eq!(c.runs, 92);
+    assert_eq!(c.runs, 74);
     for t in ["table1", "nol", "reciprocity", "reciprocity-deltas", "angles", "nerfactor", "energy"]
     {
         let md = std::fs::read_to_string(out.join(format!("tables/{t}.md"))).unwrap();

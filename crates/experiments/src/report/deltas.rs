@@ -83,6 +83,7 @@ pub fn delta_table(
                     paired_delta(&last, model, *options, baseline.options, d, *m)
                 })
                 .collect(),
+            reference: false,
         })
         .collect();
     let names: Vec<&str> = variants.iter().map(|v| v.label.as_str()).collect();

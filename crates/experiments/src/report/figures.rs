@@ -16,21 +16,26 @@ use metrics::aggregate::Score;
 
 /// `metric` against training time on `dataset`, one curve per model (default options).
 ///
-/// Each point is one training budget (the records of a model sharing `steps`): x is the mean
-/// training time and y the mean metric, both averaged per object then over objects; y is
-/// table-scaled (RMSE∛ ×100). Budgets lacking either value are skipped, models without any
-/// point are left out. The x axis is log-scaled.
+/// Each point is one snapshot step (the records of a model sharing `steps`): x is the mean
+/// wall time of the runs at that step and y the mean metric, both averaged per object then
+/// over objects; y is table-scaled (RMSE∛ ×100). Steps lacking either value are skipped,
+/// models without any point are left out. The x axis is log-scaled; `ceiling` (raw units)
+/// draws the noise ceiling as a dashed horizontal line.
 pub fn runtime_plot(
     records: &[RunRecord],
     dataset: &Dataset,
     metric: MetricKind,
+    ceiling: Option<f64>,
     profile: &str,
 ) -> LinePlot {
     let mut plot = LinePlot::new(
         format!("{} vs time - {}, profile {profile}", ascii(metric), dataset.label()),
-        "training time (s)",
+        "training wall time (s, log)",
         y_label(metric),
     );
+    if let Some(c) = ceiling {
+        plot.references.push(("noise ceiling".into(), c * metric.factor()));
+    }
     for model in ModelKind::ALL {
         let mine: Vec<&RunRecord> = records
             .iter()
@@ -165,14 +170,14 @@ mod tests {
             rec(ModelKind::SingleMlp, "a", 1000, 50.0, 28.0),
             RunRecord::new(ModelKind::Rp, d.clone(), "a").with_value(MetricKind::Psnr, 1.0),
         ];
-        let p = runtime_plot(&records, &d, MetricKind::Psnr, "quick");
+        let p = runtime_plot(&records, &d, MetricKind::Psnr, Some(40.0), "quick");
         let labels: Vec<&str> = p.series.iter().map(|s| s.label.as_str()).collect();
         assert_eq!(labels, ["Disney", "Single MLP"]);
         assert_eq!(p.series[0].points, vec![(15.0, 22.0), (100.0, 30.0)]);
         assert!(p.log_x);
         assert!(p.title.contains("MERL-derived (NBRDF), profile quick"));
         assert!(line_plot_png(&p).is_ok());
-        let r = runtime_plot(&records, &d, MetricKind::CubeRootRmse, "quick");
+        let r = runtime_plot(&records, &d, MetricKind::CubeRootRmse, None, "quick");
         assert!(r.series.is_empty());
         assert_eq!(r.y_label, "RMSE of cube roots (x100)");
     }

@@ -93,7 +93,7 @@ mod tests {
             caption: String::new(),
             stub_header: "Model".into(),
             groups: vec![],
-            rows: vec![Row { label: "RP".into(), cells: vec![] }],
+            rows: vec![Row { label: "RP".into(), cells: vec![], reference: false }],
             marking: Marking::RankColumns,
             notes: vec![],
         };
@@ -113,6 +113,7 @@ mod tests {
             rows: vec![Row {
                 label: "x".into(),
                 cells: vec![Cell::value(1.0), Cell::Score(Score::Unavailable("why".into()))],
+                reference: false,
             }],
             marking: Marking::RankColumns,
             notes: vec!["note".into()],

@@ -7,7 +7,9 @@
 //!   deltas.
 //! * [`table`], [`rank`]: the table model and its highlighting (best / second / third,
 //!   improvements); [`markdown`] and [`latex`] render it.
-//! * [`tables`]: Table 1, reciprocity RMSE, energy conservation, per-object tables.
+//! * [`tables`]: Table 1 (with the noise ceiling and against the noise-free renders),
+//!   reciprocity RMSE, energy conservation, per-object tables.
+//! * [`runtime`]: run time against accuracy (seconds to each model's plateau).
 //! * [`deltas`]: the ablations (NOL, reciprocity options, angle parametrization, NeRFactor
 //!   changes) as differences to the baseline.
 //! * [`plot`], [`grid`], [`figures`]: line plots (error against training time) and image
@@ -29,6 +31,7 @@ pub mod markdown;
 pub mod plot;
 pub mod rank;
 pub mod record;
+pub mod runtime;
 pub mod table;
 pub mod tables;
 
@@ -41,5 +44,8 @@ pub use latex::{LATEX_PREAMBLE, to_latex};
 pub use markdown::to_markdown;
 pub use plot::{LinePlot, Series, line_plot_png};
 pub use record::{Dataset, Direction, MetricKind, RunOptions, RunRecord};
+pub use runtime::time_to_accuracy;
 pub use table::{Cell, Column, ColumnGroup, Marking, Row, Table};
-pub use tables::{energy_table, per_object_table, reciprocity_table, table1};
+pub use tables::{
+    CEILING_LABEL, energy_table, per_object_table, reciprocity_table, table1, table1_noise_free,
+};

@@ -47,6 +47,8 @@ pub struct LinePlot {
     pub log_x: bool,
     /// The curves.
     pub series: Vec<Series>,
+    /// Horizontal reference lines (label, y), drawn dashed in dark grey (the noise ceiling).
+    pub references: Vec<(String, f64)>,
     /// Image width in pixels (default 960).
     pub width: u32,
     /// Image height in pixels (default 600).
@@ -68,6 +70,7 @@ impl LinePlot {
             y_label: y_label.into(),
             log_x: true,
             series: Vec::new(),
+            references: Vec::new(),
             width: 960,
             height: 600,
             font_scale: 2,
@@ -199,11 +202,12 @@ pub fn draw_line_plot(plot: &LinePlot) -> Result<(Canvas, Frame)> {
     let pad = gh / 2 + 4;
     let points = finite_points(plot);
     let xa = axis(points.iter().flatten().map(|p| p.0), plot.log_x);
-    let ya = axis(points.iter().flatten().map(|p| p.1), false);
+    let refs: Vec<&(String, f64)> = plot.references.iter().filter(|r| r.1.is_finite()).collect();
+    let ya = axis(points.iter().flatten().map(|p| p.1).chain(refs.iter().map(|r| r.1)), false);
     let y_tick_w = ya.ticks.iter().map(|t| i64::from(text_width(&t.1, fs))).max().unwrap_or(0);
-    let legend_w =
-        plot.series.iter().map(|s| i64::from(text_width(&s.label, fs))).max().unwrap_or(0);
-    let legend_w = if plot.series.is_empty() { 0 } else { legend_w + 3 * gh + 3 * pad };
+    let labels = plot.series.iter().map(|s| &s.label).chain(refs.iter().map(|r| &r.0));
+    let legend_w = labels.clone().map(|l| i64::from(text_width(l, fs))).max().unwrap_or(0);
+    let legend_w = if labels.count() == 0 { 0 } else { legend_w + 3 * gh + 3 * pad };
     let (w, h) = (i64::from(plot.width), i64::from(plot.height));
     let frame = Frame {
         left: pad + gh + pad + y_tick_w + 8,
@@ -242,8 +246,11 @@ pub fn draw_line_plot(plot: &LinePlot) -> Result<(Canvas, Frame)> {
         BLACK,
     );
 
-    // Curves, then markers on top.
+    // Reference lines (dashed), curves, then markers on top.
     let thickness = fs.max(2);
+    for r in &refs {
+        dashed_line(&mut canvas, frame.left as f64, frame.right as f64, py(r.1), gh, thickness);
+    }
     for (i, pts) in points.iter().enumerate() {
         let c = series_color(i);
         for p in pts.windows(2) {
@@ -284,7 +291,26 @@ pub fn draw_line_plot(plot: &LinePlot) -> Result<(Canvas, Frame)> {
         marker(&mut canvas, (lx + gh) as f64, mid, i, gh / 3 + 1);
         canvas.text(lx + 2 * gh + pad / 2, y, &s.label, fs, BLACK);
     }
+    for (k, r) in refs.iter().enumerate() {
+        let y = frame.top + pad + (plot.series.len() + k) as i64 * (gh + pad / 2);
+        let mid = (y + gh / 2) as f64;
+        dashed_line(&mut canvas, lx as f64, (lx + 2 * gh) as f64, mid, gh / 2, thickness);
+        canvas.text(lx + 2 * gh + pad / 2, y, &r.0, fs, BLACK);
+    }
     Ok((canvas, frame))
+}
+
+/// Colour of the reference lines.
+pub const REFERENCE: Rgb = [64, 64, 64];
+
+/// A horizontal dashed line from x0 to x1 at y, dashes of `dash` pixels.
+fn dashed_line(canvas: &mut Canvas, x0: f64, x1: f64, y: f64, dash: i64, thickness: u32) {
+    let dash = dash.max(2) as f64;
+    let mut x = x0;
+    while x < x1 {
+        canvas.line(x, y, (x + dash).min(x1), y, REFERENCE, thickness);
+        x += 2.0 * dash;
+    }
 }
 
 /// Draws marker shape `i % 5` (circle, square, triangle, diamond, cross) of radius `r` at (x, y)
@@ -342,6 +368,21 @@ mod tests {
             assert!(found, "series {i} colour {c:?} missing in the plot area");
         }
         assert!(frame.left < frame.right && frame.top < frame.bottom);
+    }
+
+    #[test]
+    fn reference_lines_are_drawn_inside_the_frame() {
+        let mut p = plot(1);
+        p.references.push(("noise ceiling".into(), 21.5));
+        let png = line_plot_png(&p).unwrap();
+        let img = image::load_from_memory(&png).unwrap().to_rgb8();
+        let (_, frame) = draw_line_plot(&p).unwrap();
+        let inside = img.enumerate_pixels().filter(|(x, y, px)| {
+            let (x, y) = (i64::from(*x), i64::from(*y));
+            px.0 == REFERENCE && x > frame.left && x < frame.right && y > frame.top
+        });
+        // Dashes cover about half the frame's width, thickness 2.
+        assert!(inside.count() as i64 > frame.right - frame.left);
     }
 
     #[test]

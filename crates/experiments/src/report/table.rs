@@ -38,6 +38,8 @@ pub struct Column {
     pub decimals: usize,
     /// Print an explicit `+` on positive values (delta columns).
     pub signed: bool,
+    /// A reference (the noise ceiling), never ranked against the others.
+    pub reference: bool,
 }
 
 impl Column {
@@ -49,7 +51,20 @@ impl Column {
             factor: metric.factor(),
             decimals: metric.decimals(),
             signed: false,
+            reference: false,
         }
+    }
+
+    /// The same column with lower values better.
+    pub fn with_direction_lower(mut self) -> Column {
+        self.direction = Direction::LowerIsBetter;
+        self
+    }
+
+    /// The same column marked as a reference (never ranked).
+    pub fn as_reference(mut self) -> Column {
+        self.reference = true;
+        self
     }
 
     /// The column of a difference of `metric` ("ΔPSNR"), signed.
@@ -109,6 +124,20 @@ pub struct Row {
     pub label: String,
     /// The cells; missing trailing cells print as not run.
     pub cells: Vec<Cell>,
+    /// A reference row (the noise ceiling), never ranked against the others.
+    pub reference: bool,
+}
+
+impl Row {
+    /// A row of results.
+    pub fn new(label: impl Into<String>, cells: Vec<Cell>) -> Row {
+        Row { label: label.into(), cells, reference: false }
+    }
+
+    /// A reference row (never ranked).
+    pub fn reference(label: impl Into<String>, cells: Vec<Cell>) -> Row {
+        Row { label: label.into(), cells, reference: true }
+    }
 }
 
 /// Which cells a table highlights.
@@ -168,7 +197,11 @@ impl Table {
         let columns = self.columns();
         let (nr, nc) = (self.rows.len(), columns.len());
         let mut marks = vec![vec![Mark::None; nc]; nr];
-        let printed = |r: usize, c: usize| columns[c].printed(self.cell(r, c));
+        // References (the noise ceiling) are shown but never ranked.
+        let printed = |r: usize, c: usize| {
+            let reference = columns[c].reference || self.rows[r].reference;
+            if reference { None } else { columns[c].printed(self.cell(r, c)) }
+        };
         match self.marking {
             Marking::None => {}
             Marking::RankColumns | Marking::Improvement => {
@@ -273,27 +306,22 @@ pub(crate) fn sample_table() -> Table {
             },
         ],
         rows: vec![
-            Row {
-                label: "RP".into(),
-                cells: vec![Cell::value(30.0), unavailable(), Cell::value(0.05), Cell::value(1.0)],
-            },
-            Row {
-                label: "Add. Sep.".into(),
-                cells: vec![Cell::value(32.5), unavailable(), Cell::value(0.04), Cell::NotRun],
-            },
-            Row {
-                label: "Enh. Add. Shared".into(),
-                cells: vec![
-                    Cell::value(32.5),
-                    unavailable(),
-                    Cell::value(0.06),
-                    Cell::value(12.25),
-                ],
-            },
-            Row {
-                label: "Disney".into(),
-                cells: vec![Cell::value(29.0), unavailable(), Cell::value(0.07), Cell::value(0.5)],
-            },
+            Row::new(
+                "RP",
+                vec![Cell::value(30.0), unavailable(), Cell::value(0.05), Cell::value(1.0)],
+            ),
+            Row::new(
+                "Add. Sep.",
+                vec![Cell::value(32.5), unavailable(), Cell::value(0.04), Cell::NotRun],
+            ),
+            Row::new(
+                "Enh. Add. Shared",
+                vec![Cell::value(32.5), unavailable(), Cell::value(0.06), Cell::value(12.25)],
+            ),
+            Row::new(
+                "Disney",
+                vec![Cell::value(29.0), unavailable(), Cell::value(0.07), Cell::value(0.5)],
+            ),
         ],
         marking: Marking::RankColumns,
         notes: vec!["Values ×100 except PSNR and %.".into()],
@@ -329,7 +357,7 @@ mod tests {
             rows: cells
                 .into_iter()
                 .enumerate()
-                .map(|(i, cells)| Row { label: format!("m{i}"), cells })
+                .map(|(i, cells)| Row::new(format!("m{i}"), cells))
                 .collect(),
             marking,
             notes: vec![],

@@ -10,7 +10,8 @@ use super::average::{average, datasets, final_records, objects, per_object};
 use super::record::{Dataset, MetricKind, RunOptions, RunRecord};
 use super::table::{Cell, Column, ColumnGroup, Marking, Row, Table};
 use brdf_neural::{ModelKind, Reciprocity};
-use metrics::aggregate::PerObjectMean;
+use metrics::aggregate::{PerObjectMean, Score};
+use std::collections::BTreeMap;
 
 /// "`title` Data: `labels`. Profile: `profile`."
 pub(crate) fn caption(title: &str, data: &[Dataset], profile: &str) -> String {
@@ -29,12 +30,31 @@ pub(crate) fn image_metrics(dataset: &Dataset) -> Vec<MetricKind> {
     m
 }
 
-/// A column of a model table: its header, the options and the metric it shows.
-type ColumnSpec = (Column, RunOptions, MetricKind);
+/// What a column of a model table shows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Source {
+    /// A metric of the runs with these options.
+    Metric(RunOptions, MetricKind),
+    /// How far the model's PSNR is below the noise ceiling (dB, per object then averaged).
+    CeilingGap,
+}
 
-/// Rows of models, one group per data set with one column per (label, options, metric).
+/// A column of a model table: its header and what it shows.
+type ColumnSpec = (Column, Source);
+
+/// The metric columns of `metrics` with default options.
+fn metric_columns(metrics: impl IntoIterator<Item = MetricKind>) -> Vec<ColumnSpec> {
+    metrics
+        .into_iter()
+        .map(|m| (Column::metric(m), Source::Metric(RunOptions::DEFAULT, m)))
+        .collect()
+}
+
+/// Rows of models, one group per data set with one column per spec; with the noise ceiling's
+/// records, a last "Ground truth (noise ceiling)" reference row.
 fn model_table(
     records: &[&RunRecord],
+    ceiling: &[&RunRecord],
     data: &[Dataset],
     columns: impl Fn(&Dataset) -> Vec<ColumnSpec>,
 ) -> (Vec<ColumnGroup>, Vec<Row>) {
@@ -47,36 +67,70 @@ fn model_table(
             columns: cols.iter().map(|c| c.0.clone()).collect(),
         })
         .collect();
-    let rows = ModelKind::ALL
+    let mut rows: Vec<Row> = ModelKind::ALL
         .iter()
-        .map(|&model| Row {
-            label: model.paper_name().to_string(),
-            cells: specs
+        .map(|&model| {
+            let cells = specs
                 .iter()
                 .flat_map(|(d, cols)| {
-                    cols.iter().map(move |(_, options, metric)| {
-                        average(records, model, *options, d, *metric)
+                    cols.iter().map(move |(_, source)| match *source {
+                        Source::Metric(options, metric) => {
+                            average(records, model, options, d, metric)
+                        }
+                        Source::CeilingGap => ceiling_gap(records, ceiling, model, d),
                     })
                 })
-                .collect(),
+                .collect();
+            Row::new(model.paper_name(), cells)
         })
         .collect();
+    if specs.iter().any(|(d, _)| ceiling.iter().any(|r| &r.dataset == d)) {
+        let cells = specs
+            .iter()
+            .flat_map(|(d, cols)| {
+                cols.iter().map(move |(_, source)| match *source {
+                    Source::Metric(_, m) if MetricKind::IMAGE.contains(&m) => {
+                        reference_average(ceiling, d, m)
+                    }
+                    _ => Cell::NotRun,
+                })
+            })
+            .collect();
+        rows.push(Row::reference(CEILING_LABEL, cells));
+    }
     (groups, rows)
 }
 
+/// The row label of the noise ceiling.
+pub const CEILING_LABEL: &str = "Ground truth (noise ceiling)";
+
 /// Table 1: the nine models with default options; per data set PSNR↑, DSSIM↓, LPIPS↓, FLIP↓
-/// and, for MERL-derived data, RMSE∛↓ (all but PSNR ×100). Best / second / third per column.
-pub fn table1(records: &[RunRecord], profile: &str) -> Table {
+/// and, for MERL-derived data, RMSE∛↓ (all but PSNR ×100), then how far each model's PSNR is
+/// below the noise ceiling and its training time. `ceiling` holds the noise ceiling's records
+/// (one per evaluated run of a semi-synthetic scene): its row closes the table, never ranked.
+/// Best / second / third per column.
+pub fn table1(records: &[RunRecord], ceiling: &[RunRecord], profile: &str) -> Table {
     let last = final_records(records);
+    let ceiling: Vec<&RunRecord> = ceiling.iter().collect();
     let data = datasets(&last);
-    let (groups, rows) = model_table(&last, &data, |d| {
-        image_metrics(d).into_iter().map(|m| (Column::metric(m), RunOptions::DEFAULT, m)).collect()
+    let (groups, rows) = model_table(&last, &ceiling, &data, |d| {
+        let mut cols = metric_columns(image_metrics(d));
+        if ceiling.iter().any(|r| &r.dataset == d) {
+            cols.push((ceiling_gap_column(), Source::CeilingGap));
+        }
+        let time = Column::metric(MetricKind::TrainingSeconds);
+        let time = Column { direction: super::record::Direction::Neutral, ..time };
+        cols.push((time, Source::Metric(RunOptions::DEFAULT, MetricKind::TrainingSeconds)));
+        cols
     });
     Table {
         caption: caption(
-            "Table 1: image metrics of the models with default options, averaged per object, \
-             then over objects; DSSIM, LPIPS, FLIP and RMSE∛ ×100 (RMSE∛ only where a \
-             ground-truth BRDF exists).",
+            "Table 1: image metrics of the models with default options against the observed \
+             (noisy) test images, averaged per object, then over objects; DSSIM, LPIPS, FLIP \
+             and RMSE∛ ×100 (RMSE∛ only where a ground-truth BRDF exists). The ground truth's \
+             own noise-free renders score the noise ceiling, the best any model can; \
+             'below ceiling' is its PSNR minus the model's; time is the training wall time \
+             per run.",
             &data,
             profile,
         ),
@@ -88,13 +142,81 @@ pub fn table1(records: &[RunRecord], profile: &str) -> Table {
     }
 }
 
+/// Table 1's models scored against the noise-free test renders instead of the observed
+/// images (semi-synthetic data only: the records carry the metrics against the noise-free
+/// renders). The ground truth would score ∞ dB here and is left out.
+pub fn table1_noise_free(records: &[RunRecord], profile: &str) -> Table {
+    let last = final_records(records);
+    let data = datasets(&last);
+    let (groups, rows) =
+        model_table(&last, &[], &data, |_| metric_columns(MetricKind::IMAGE.to_vec()));
+    Table {
+        caption: caption(
+            "Table 1 against the noise-free test renders: the models' renders scored against \
+             the ground truth's noise-free images instead of the noisy observations (the \
+             noise removed), averaged per object, then over objects; DSSIM, LPIPS and FLIP \
+             ×100. The ground truth scores ∞ dB here.",
+            &data,
+            profile,
+        ),
+        stub_header: "Model".into(),
+        groups,
+        rows,
+        marking: Marking::RankColumns,
+        notes: vec![],
+    }
+}
+
+/// The column of [`Source::CeilingGap`].
+fn ceiling_gap_column() -> Column {
+    Column::metric(MetricKind::Psnr).labelled("below ceiling (dB)").with_direction_lower()
+}
+
+/// Mean over objects of the per-object means of `metric` over every record of `dataset`
+/// (the noise ceiling's records: any model, any options).
+fn reference_average(records: &[&RunRecord], dataset: &Dataset, metric: MetricKind) -> Cell {
+    let mut mean = PerObjectMean::new();
+    let mut any = false;
+    for r in records.iter().filter(|r| &r.dataset == dataset) {
+        if let Some(score) = r.metric(metric) {
+            mean.push(&r.object, score.clone());
+            any = true;
+        }
+    }
+    if any { Cell::Score(mean.overall()) } else { Cell::NotRun }
+}
+
+/// Ceiling PSNR minus the model's, per object (objects with both), then averaged.
+fn ceiling_gap(
+    records: &[&RunRecord],
+    ceiling: &[&RunRecord],
+    model: ModelKind,
+    dataset: &Dataset,
+) -> Cell {
+    let Some(ours) = per_object(records, model, RunOptions::DEFAULT, dataset, MetricKind::Psnr)
+    else {
+        return Cell::NotRun;
+    };
+    let mut mean = PerObjectMean::new();
+    for (object, score) in ours {
+        let mine: Vec<&RunRecord> =
+            ceiling.iter().copied().filter(|r| r.object == object).collect();
+        let Cell::Score(Score::Value(c)) = reference_average(&mine, dataset, MetricKind::Psnr)
+        else {
+            continue;
+        };
+        mean.push(&object, score.value().map_or(score.clone(), |v| Score::Value(c - v)));
+    }
+    if mean.per_object().is_empty() { Cell::NotRun } else { Cell::Score(mean.overall()) }
+}
+
 /// Reciprocity RMSE (not scaled) of every model under each reciprocity option: none, random
 /// swap and the mapping Θ (the options apply to the purely neural models; the parametric ones
 /// run with none only). Lower is better, ranked per column.
 pub fn reciprocity_table(records: &[RunRecord], profile: &str) -> Table {
     let last = final_records(records);
     let data = datasets(&last);
-    let (groups, rows) = model_table(&last, &data, |_| {
+    let (groups, rows) = model_table(&last, &[], &data, |_| {
         [
             ("none", Reciprocity::None),
             ("swap", Reciprocity::RandomSwap),
@@ -104,7 +226,7 @@ pub fn reciprocity_table(records: &[RunRecord], profile: &str) -> Table {
         .map(|(label, reciprocity)| {
             let options = RunOptions { reciprocity, ..RunOptions::DEFAULT };
             let m = MetricKind::ReciprocityRmse;
-            (Column::metric(m).labelled(label), options, m)
+            (Column::metric(m).labelled(label), Source::Metric(options, m))
         })
         .collect()
     });
@@ -128,11 +250,8 @@ pub fn reciprocity_table(records: &[RunRecord], profile: &str) -> Table {
 pub fn energy_table(records: &[RunRecord], profile: &str) -> Table {
     let last = final_records(records);
     let data = datasets(&last);
-    let (groups, rows) = model_table(&last, &data, |_| {
-        [MetricKind::EnergyPercentAbove1, MetricKind::EnergyMedianAbove1]
-            .into_iter()
-            .map(|m| (Column::metric(m), RunOptions::DEFAULT, m))
-            .collect()
+    let (groups, rows) = model_table(&last, &[], &data, |_| {
+        metric_columns([MetricKind::EnergyPercentAbove1, MetricKind::EnergyMedianAbove1])
     });
     Table {
         caption: caption(
@@ -150,49 +269,62 @@ pub fn energy_table(records: &[RunRecord], profile: &str) -> Table {
 }
 
 /// `metric` per object (rows, plus a final "Mean" row) and model (columns, default options) on
-/// `dataset`; the best / second / third model of each row is marked.
+/// `dataset`; the best / second / third model of each row is marked. For an image metric, the
+/// noise ceiling's records add a last reference column (never ranked).
 pub fn per_object_table(
     records: &[RunRecord],
+    ceiling: &[RunRecord],
     dataset: &Dataset,
     metric: MetricKind,
     profile: &str,
 ) -> Table {
     let last = final_records(records);
     let names = objects(&last, dataset);
-    let per_model: Vec<_> = ModelKind::ALL
+    let mut per_column: Vec<Option<BTreeMap<String, Score>>> = ModelKind::ALL
         .iter()
         .map(|&m| per_object(&last, m, RunOptions::DEFAULT, dataset, metric))
         .collect();
+    let mut columns: Vec<Column> =
+        ModelKind::ALL.iter().map(|m| Column::metric(metric).labelled(m.paper_name())).collect();
+    let ceiling: Vec<&RunRecord> = ceiling.iter().filter(|r| &r.dataset == dataset).collect();
+    if MetricKind::IMAGE.contains(&metric) && !ceiling.is_empty() {
+        let mut mean = PerObjectMean::new();
+        for r in &ceiling {
+            if let Some(score) = r.metric(metric) {
+                mean.push(&r.object, score.clone());
+            }
+        }
+        per_column.push(Some(mean.per_object()));
+        columns.push(Column::metric(metric).labelled(CEILING_LABEL).as_reference());
+    }
     let mut rows: Vec<Row> = names
         .iter()
-        .map(|object| Row {
-            label: object.clone(),
-            cells: per_model
+        .map(|object| {
+            let cells = per_column
                 .iter()
                 .map(|p| {
                     p.as_ref()
                         .and_then(|p| p.get(object))
                         .map_or(Cell::NotRun, |s| Cell::Score(s.clone()))
                 })
-                .collect(),
+                .collect();
+            Row::new(object.clone(), cells)
         })
         .collect();
-    rows.push(Row {
-        label: "Mean".into(),
-        cells: per_model
-            .iter()
-            .map(|p| match p {
-                None => Cell::NotRun,
-                Some(p) => {
-                    let mut mean = PerObjectMean::new();
-                    for (object, score) in p {
-                        mean.push(object, score.clone());
-                    }
-                    Cell::Score(mean.overall())
+    let means = per_column
+        .iter()
+        .map(|p| match p {
+            None => Cell::NotRun,
+            Some(p) => {
+                let mut mean = PerObjectMean::new();
+                for (object, score) in p {
+                    mean.push(object, score.clone());
                 }
-            })
-            .collect(),
-    });
+                Cell::Score(mean.overall())
+            }
+        })
+        .collect();
+    rows.push(Row::new("Mean", means));
     let scale = if metric.factor() == 1.0 { String::new() } else { " (×100)".to_string() };
     Table {
         caption: caption(
@@ -201,13 +333,7 @@ pub fn per_object_table(
             profile,
         ),
         stub_header: "Object".into(),
-        groups: vec![ColumnGroup {
-            title: dataset.label().to_string(),
-            columns: ModelKind::ALL
-                .iter()
-                .map(|m| Column::metric(metric).labelled(m.paper_name()))
-                .collect(),
-        }],
+        groups: vec![ColumnGroup { title: dataset.label().to_string(), columns }],
         rows,
         marking: Marking::RankRows,
         notes: vec![],
@@ -239,22 +365,64 @@ mod tests {
             RunRecord::new(ModelKind::Rp, Dataset::MerlNbrdf, "spot")
                 .with_value(MetricKind::CubeRootRmse, 0.1),
         ];
-        let t = table1(&records, "quick");
+        let t = table1(&records, &[], "quick");
         assert_eq!(t.rows.len(), 9);
         assert_eq!(t.groups[0].title, "MERL-derived (NBRDF)");
-        assert_eq!(t.groups[0].columns.len(), 5);
+        // The image metrics, RMSE∛ for MERL-derived data, and the training time.
+        assert_eq!(t.groups[0].columns.len(), 6);
         assert_eq!(t.groups[1].title, "DiLiGenT-MV");
-        assert_eq!(t.groups[1].columns.len(), 4);
+        assert_eq!(t.groups[1].columns.len(), 5);
         assert!(t.caption.contains("Data: MERL-derived (NBRDF), DiLiGenT-MV. Profile: quick."));
         // Disney row (index 3), DiLiGenT-MV PSNR: (32 + 20) / 2.
         assert_eq!(t.rows[3].label, "Disney");
-        assert_eq!(t.cell_text(3, 5), "26.00");
-        assert_eq!(t.cell_text(3, 7), "n/a");
+        assert_eq!(t.cell_text(3, 6), "26.00");
+        assert_eq!(t.cell_text(3, 8), "n/a");
         assert_eq!(t.cell_text(0, 4), "10.00");
-        assert_eq!(t.cell_text(1, 5), "–");
+        assert_eq!(t.cell_text(1, 6), "–");
         let md = to_markdown(&t);
         assert!(md.contains("n/a not computable (weights missing)"), "{md}");
-        assert!(to_latex(&t).contains("\\multicolumn{4}{c}{DiLiGenT-MV}"));
+        assert!(to_latex(&t).contains("\\multicolumn{5}{c}{DiLiGenT-MV}"));
+    }
+
+    #[test]
+    fn the_noise_ceiling_closes_table1_unranked_with_each_models_gap() {
+        let d = Dataset::MerlNbrdf;
+        let run = |model, object: &str, psnr: f64| {
+            RunRecord::new(model, d.clone(), object)
+                .with_value(MetricKind::Psnr, psnr)
+                .with_value(MetricKind::TrainingSeconds, 60.0)
+        };
+        let records = vec![
+            run(ModelKind::Ts, "a", 40.0),
+            run(ModelKind::Ts, "b", 30.0),
+            run(ModelKind::SingleMlp, "a", 44.0),
+        ];
+        // The ceiling as every run of an object reports it (identical per object).
+        let ceiling: Vec<RunRecord> = [("a", 45.0), ("a", 45.0), ("b", 41.0)]
+            .iter()
+            .map(|&(o, p)| {
+                RunRecord::new(ModelKind::Ts, d.clone(), o).with_value(MetricKind::Psnr, p)
+            })
+            .collect();
+        let t = table1(&records, &ceiling, "quick");
+        let last = t.rows.len() - 1;
+        assert_eq!(t.rows[last].label, CEILING_LABEL);
+        assert!(t.rows[last].reference);
+        let labels: Vec<&str> = t.columns().iter().map(|c| c.label.as_str()).collect();
+        let gap = labels.iter().position(|l| l.contains("below ceiling")).unwrap();
+        // Ceiling PSNR: (45 + 41) / 2; TS gap: ((45 - 40) + (41 - 30)) / 2; Single MLP: 45 - 44.
+        assert_eq!(t.cell_text(last, 0), "43.00");
+        assert_eq!(t.cell_text(1, gap), "8.00");
+        assert_eq!(t.cell_text(4, gap), "1.00");
+        assert_eq!(t.cell_text(last, gap), "–");
+        // Never ranked: Single MLP is best in PSNR although the ceiling is higher.
+        assert_eq!(t.marks()[4][0], super::super::rank::Mark::First);
+        assert_eq!(t.marks()[last][0], super::super::rank::Mark::None);
+        // The per-object table gets the ceiling as a last, unranked column.
+        let p = per_object_table(&records, &ceiling, &d, MetricKind::Psnr, "quick");
+        assert_eq!(p.columns().last().unwrap().label, CEILING_LABEL);
+        assert_eq!(p.cell_text(0, 9), "45.00");
+        assert_eq!(p.marks()[0][4], super::super::rank::Mark::First);
     }
 
     #[test]
@@ -263,9 +431,9 @@ mod tests {
             RunRecord::new(ModelKind::Rp, Dataset::MerlNbrdf, "spot")
                 .with_value(MetricKind::Psnr, 30.0),
         ];
-        let t = table1(&records, "cpu");
+        let t = table1(&records, &[], "cpu");
         assert_eq!(t.groups.len(), 1);
-        assert!(table1(&[], "cpu").caption.contains("Data: none."));
+        assert!(table1(&[], &[], "cpu").caption.contains("Data: none."));
     }
 
     #[test]
@@ -299,7 +467,7 @@ mod tests {
             rec(ModelKind::Rp, "bear", 25.0, 0.05),
             rec(ModelKind::Rp, "cow", 21.0, 0.05),
         ];
-        let t = per_object_table(&records, &Dataset::DiligentMv, MetricKind::Psnr, "quick");
+        let t = per_object_table(&records, &[], &Dataset::DiligentMv, MetricKind::Psnr, "quick");
         let labels: Vec<&str> = t.rows.iter().map(|r| r.label.as_str()).collect();
         assert_eq!(labels, ["bear", "cow", "Mean"]);
         assert_eq!(t.columns().len(), 9);

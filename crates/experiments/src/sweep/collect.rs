@@ -6,12 +6,13 @@
 //! scene directory). Written, atomically, under `<out>/`:
 //!
 //! ```text
-//! tables/table1.{md,tex}           Table 1 (every data set present)
+//! tables/table1.{md,tex}           Table 1 (every data set present), with the noise ceiling
+//! tables/table1-noise-free.*       Table 1 against the noise-free test renders
 //! tables/nol.{md,tex}              NOL deltas            tables/reciprocity.{md,tex}
 //! tables/reciprocity-deltas.*      swap / mapping deltas tables/angles.{md,tex}
 //! tables/nerfactor.{md,tex}        NeRFactor changes     tables/energy.{md,tex}
 //! tables/per-object-psnr.*         per object            tables/per-object-rmse.*
-//! tables/runtime.md                run time against error (steps, seconds, PSNR, RMSE∛)
+//! tables/runtime.{md,tex}         run time against accuracy (seconds to each plateau)
 //! tables/all.md                    every table in one file
 //! figures/qualitative-<object>.png GT and every model's render with its PSNR, FLIP maps
 //! figures/split-<object>.png       additive models: render, diffuse, specular, albedo
@@ -20,6 +21,8 @@
 
 use super::plan::{self, Purpose};
 use crate::config::RunConfig;
+use crate::eval::ImageMetrics;
+use crate::plateau::StopReason;
 use crate::report::{
     self, Dataset, MetricKind, ModelRender, QualitativeRow, RgbImage, RunOptions, RunRecord, Table,
 };
@@ -37,8 +40,24 @@ pub struct CollectedRun {
     pub config: RunConfig,
     /// Why it ran.
     pub purposes: Vec<Purpose>,
-    /// The record of its final weights.
+    /// The record of its final weights (scored against the observed images).
     pub record: RunRecord,
+    /// The same scored against the noise-free test renders (semi-synthetic scenes).
+    pub noise_free: Option<RunRecord>,
+    /// The noise ceiling of its scene (semi-synthetic scenes).
+    pub ceiling: Option<RunRecord>,
+    /// Its run-time curve: the snapshots' scores and the final weights' (runs with
+    /// snapshots).
+    pub curve: Vec<RunRecord>,
+    /// Why its training stopped (absent for runs of older versions).
+    pub stop_reason: Option<StopReason>,
+}
+
+impl CollectedRun {
+    /// Whether its training is known to have converged (the plateau rule stopped it).
+    pub fn converged(&self) -> bool {
+        self.stop_reason.is_some_and(StopReason::converged)
+    }
 }
 
 /// Every run directory below `paths` (a directory holding `config.toml` and `metrics.json`).
@@ -87,16 +106,18 @@ pub fn read_run(dir: &Path) -> Result<Option<CollectedRun>> {
         Some(x) => Score::Value(x),
         None => Score::Unavailable(why.into()),
     };
-    let mut r = RunRecord::new(config.model.kind, dataset, object)
-        .with_options(RunOptions::of(&config.model))
-        .with_value(MetricKind::Psnr, t.psnr)
-        .with_value(MetricKind::Dssim, t.dssim)
-        .with_value(MetricKind::Flip, t.flip)
-        .with(
-            MetricKind::Lpips,
-            opt(t.lpips, t.lpips_unavailable.as_deref().unwrap_or("not computed")),
-        )
-        .with_value(MetricKind::TrainingSeconds, m.wall_seconds);
+    let base = RunRecord::new(config.model.kind, dataset, object)
+        .with_options(RunOptions::of(&config.model));
+    let why_no_lpips = t.lpips_unavailable.as_deref().unwrap_or("not computed");
+    let images = |r: RunRecord, m: &ImageMetrics| {
+        r.with_value(MetricKind::Psnr, m.psnr)
+            .with_value(MetricKind::Dssim, m.dssim)
+            .with_value(MetricKind::Flip, m.flip)
+            .with(MetricKind::Lpips, opt(m.lpips, why_no_lpips))
+    };
+    let observed = ImageMetrics { psnr: t.psnr, dssim: t.dssim, flip: t.flip, lpips: t.lpips };
+    let mut r =
+        images(base.clone(), &observed).with_value(MetricKind::TrainingSeconds, m.wall_seconds);
     if let Some(v) = t.rmse_cbrt {
         r = r.with_value(MetricKind::CubeRootRmse, v);
     }
@@ -107,7 +128,59 @@ pub fn read_run(dir: &Path) -> Result<Option<CollectedRun>> {
         r = r.with_value(MetricKind::EnergyPercentAbove1, e.percent_above_one);
         r = r.with(MetricKind::EnergyMedianAbove1, opt(e.median_above_one, "no pair above 1"));
     }
-    Ok(Some(CollectedRun { dir: dir.to_path_buf(), config, purposes, record: r }))
+    let noise_free = t.clean.as_ref().map(|c| images(base.clone(), c));
+    let ceiling = t.ceiling.as_ref().map(|c| images(base.clone(), c));
+    let point = |steps: u64, seconds: f64, psnr: f64, rmse: Option<f64>| {
+        let p = base
+            .clone()
+            .at_steps(steps)
+            .with_value(MetricKind::TrainingSeconds, seconds)
+            .with_value(MetricKind::Psnr, psnr);
+        match rmse {
+            Some(v) => p.with_value(MetricKind::CubeRootRmse, v),
+            None => p,
+        }
+    };
+    let mut curve: Vec<RunRecord> =
+        t.curve.iter().map(|c| point(c.step, c.seconds, c.psnr, c.rmse_cbrt)).collect();
+    if !curve.is_empty() {
+        curve.push(point(m.steps, m.wall_seconds, t.psnr, t.rmse_cbrt));
+    }
+    Ok(Some(CollectedRun {
+        dir: dir.to_path_buf(),
+        config,
+        purposes,
+        record: r,
+        noise_free,
+        ceiling,
+        curve,
+        stop_reason: m.stop_reason,
+    }))
+}
+
+/// The note under the tables when runs stopped before converging, naming them.
+pub fn convergence_note(runs: &[&CollectedRun]) -> Option<String> {
+    let open: Vec<&&CollectedRun> = runs.iter().filter(|r| !r.converged()).collect();
+    if open.is_empty() {
+        return None;
+    }
+    let mut names: Vec<String> = open
+        .iter()
+        .map(|r| format!("{} on {}", r.record.model.paper_name(), r.record.object))
+        .collect();
+    if names.len() > 8 {
+        let more = names.len() - 6;
+        names.truncate(6);
+        names.push(format!("{more} more"));
+    }
+    Some(format!(
+        "Not converged: {} of {} runs stopped at their step budget before their validation \
+         loss reached a plateau ({}); more training would change their scores. Profiles with \
+         a larger budget (the default) train every run to its plateau.",
+        open.len(),
+        runs.len(),
+        names.join(", ")
+    ))
 }
 
 /// The data set of a scene directory, from its manifest: captured scenes name their benchmark,
@@ -158,62 +231,45 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
             "no evaluated run found",
         ));
     }
-    let table_records: Vec<RunRecord> = runs
-        .iter()
-        .filter(|r| r.purposes.iter().any(|p| *p != Purpose::Runtime))
-        .map(|r| r.record.clone())
-        .collect();
-    let runtime_records: Vec<RunRecord> = runs
-        .iter()
-        .filter(|r| r.purposes.contains(&Purpose::Runtime))
-        .map(|r| r.record.clone().at_steps(r.config.train.iterations))
-        .collect();
+    let table_runs: Vec<&CollectedRun> =
+        runs.iter().filter(|r| r.purposes.iter().any(|p| *p != Purpose::Runtime)).collect();
+    let ceiling: Vec<RunRecord> = runs.iter().filter_map(|r| r.ceiling.clone()).collect();
     let mut all_md = String::new();
-    if !table_records.is_empty() {
-        let rec = &table_records;
-        let mut tables: Vec<(String, Table)> = vec![
-            ("table1".into(), report::table1(rec, profile)),
-            ("nol".into(), report::nol_deltas(rec, profile)),
-            ("reciprocity".into(), report::reciprocity_table(rec, profile)),
-            ("reciprocity-deltas".into(), report::reciprocity_deltas(rec, profile)),
-            ("angles".into(), report::parametrization_deltas(rec, profile)),
-            ("nerfactor".into(), report::nerfactor_deltas(rec, profile)),
-            ("energy".into(), report::energy_table(rec, profile)),
-        ];
-        for (d, tag) in [
-            (Dataset::MerlNbrdf, ""),
-            (Dataset::DiligentMv, "-diligent-mv"),
-            (Dataset::Diligent, "-diligent"),
-        ] {
-            if rec.iter().any(|r| r.dataset == d) {
-                let psnr = report::per_object_table(rec, &d, MetricKind::Psnr, profile);
-                tables.push((format!("per-object-psnr{tag}"), psnr));
-                if d.has_brdf_ground_truth() {
-                    let rmse = report::per_object_table(rec, &d, MetricKind::CubeRootRmse, profile);
-                    tables.push((format!("per-object-rmse{tag}"), rmse));
+    if !table_runs.is_empty() {
+        let rec: Vec<RunRecord> = table_runs.iter().map(|r| r.record.clone()).collect();
+        let noise_free: Vec<RunRecord> =
+            table_runs.iter().filter_map(|r| r.noise_free.clone()).collect();
+        let mut tables = result_tables(&rec, &noise_free, &ceiling, profile);
+        let table1_runs: Vec<&CollectedRun> = table_runs
+            .iter()
+            .copied()
+            .filter(|r| {
+                r.purposes.contains(&Purpose::Table) && r.record.options == RunOptions::DEFAULT
+            })
+            .collect();
+        if let Some(note) = convergence_note(&table1_runs) {
+            for (name, t) in &mut tables {
+                if name.starts_with("table1") || name.starts_with("per-object") {
+                    t.notes.push(note.clone());
                 }
             }
         }
-        for (name, t) in &tables {
-            let md = report::to_markdown(t);
-            write(out, &format!("tables/{name}.md"), md.as_bytes(), &mut summary)?;
-            write(
-                out,
-                &format!("tables/{name}.tex"),
-                report::to_latex(t).as_bytes(),
-                &mut summary,
-            )?;
-            all_md.push_str(&md);
-            all_md.push('\n');
-        }
+        write_tables(&tables, out, &mut all_md, &mut summary)?;
         figures(&runs, out, &mut summary)?;
     }
-    if !runtime_records.is_empty() {
-        let md = runtime_markdown(&runtime_records, profile);
-        write(out, "tables/runtime.md", md.as_bytes(), &mut summary)?;
-        all_md.push_str(&md);
+    let curves: Vec<RunRecord> = runs
+        .iter()
+        .filter(|r| r.purposes.contains(&Purpose::Runtime))
+        .flat_map(|r| r.curve.iter().cloned())
+        .collect();
+    if !curves.is_empty() {
+        let t = report::time_to_accuracy(&curves, &ceiling, profile);
+        write_tables(&[("runtime".into(), t)], out, &mut all_md, &mut summary)?;
+        let c = ceiling_psnr(&ceiling, &curves);
         for (metric, name) in [(MetricKind::Psnr, "psnr"), (MetricKind::CubeRootRmse, "rmse")] {
-            let plot = report::runtime_plot(&runtime_records, &Dataset::MerlNbrdf, metric, profile);
+            let reference = if metric == MetricKind::Psnr { c } else { None };
+            let d = Dataset::MerlNbrdf;
+            let plot = report::runtime_plot(&curves, &d, metric, reference, profile);
             if !plot.series.is_empty() {
                 let png = report::line_plot_png(&plot)?;
                 write(out, &format!("figures/runtime-{name}.png"), &png, &mut summary)?;
@@ -224,33 +280,70 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
     Ok(summary)
 }
 
-/// The run-time table: per model and budget, steps, training seconds, PSNR and RMSE∛ (x100).
-fn runtime_markdown(records: &[RunRecord], profile: &str) -> String {
-    let mut rows: Vec<&RunRecord> = records.iter().collect();
-    rows.sort_by_key(|r| (r.model as usize, r.steps));
-    let mut s = format!(
-        "**Run time against error: MERL-derived (NBRDF), profile {profile} (averaged over objects)**\n\n\
-         | model | steps | train time (s) | PSNR ↑ | RMSE∛ ×100 ↓ |\n| --- | ---: | ---: | ---: | ---: |\n"
-    );
-    let value = |r: &RunRecord, m: MetricKind| match r.metric(m) {
-        Some(Score::Value(v)) => Some(*v),
-        _ => None,
-    };
-    for r in rows {
-        let f = |v: Option<f64>, scale: f64, d: usize| {
-            v.map_or("n/a".into(), |x| format!("{:.*}", d, x * scale))
-        };
-        s.push_str(&format!(
-            "| {} | {} | {} | {} | {} |\n",
-            r.model.paper_name(),
-            r.steps.unwrap_or(0),
-            f(value(r, MetricKind::TrainingSeconds), 1.0, 1),
-            f(value(r, MetricKind::Psnr), 1.0, 2),
-            f(value(r, MetricKind::CubeRootRmse), 100.0, 2),
-        ));
+/// Every result table of the runs (not the run-time one), with its file stem.
+fn result_tables(
+    rec: &[RunRecord],
+    noise_free: &[RunRecord],
+    ceiling: &[RunRecord],
+    profile: &str,
+) -> Vec<(String, Table)> {
+    let mut tables: Vec<(String, Table)> =
+        vec![("table1".into(), report::table1(rec, ceiling, profile))];
+    if !noise_free.is_empty() {
+        tables.push(("table1-noise-free".into(), report::table1_noise_free(noise_free, profile)));
     }
-    s.push('\n');
-    s
+    tables.extend([
+        ("nol".into(), report::nol_deltas(rec, profile)),
+        ("reciprocity".into(), report::reciprocity_table(rec, profile)),
+        ("reciprocity-deltas".into(), report::reciprocity_deltas(rec, profile)),
+        ("angles".into(), report::parametrization_deltas(rec, profile)),
+        ("nerfactor".into(), report::nerfactor_deltas(rec, profile)),
+        ("energy".into(), report::energy_table(rec, profile)),
+    ]);
+    for (d, tag) in [
+        (Dataset::MerlNbrdf, ""),
+        (Dataset::DiligentMv, "-diligent-mv"),
+        (Dataset::Diligent, "-diligent"),
+    ] {
+        if rec.iter().any(|r| r.dataset == d) {
+            let psnr = report::per_object_table(rec, ceiling, &d, MetricKind::Psnr, profile);
+            tables.push((format!("per-object-psnr{tag}"), psnr));
+            if d.has_brdf_ground_truth() {
+                let rmse =
+                    report::per_object_table(rec, ceiling, &d, MetricKind::CubeRootRmse, profile);
+                tables.push((format!("per-object-rmse{tag}"), rmse));
+            }
+        }
+    }
+    tables
+}
+
+/// Writes each table as Markdown and LaTeX and appends the Markdown to `all_md`.
+fn write_tables(
+    tables: &[(String, Table)],
+    out: &Path,
+    all_md: &mut String,
+    summary: &mut CollectSummary,
+) -> Result<()> {
+    for (name, t) in tables {
+        let md = report::to_markdown(t);
+        write(out, &format!("tables/{name}.md"), md.as_bytes(), summary)?;
+        write(out, &format!("tables/{name}.tex"), report::to_latex(t).as_bytes(), summary)?;
+        all_md.push_str(&md);
+        all_md.push('\n');
+    }
+    Ok(())
+}
+
+/// The mean noise-ceiling PSNR over the objects of the run-time curves.
+fn ceiling_psnr(ceiling: &[RunRecord], curves: &[RunRecord]) -> Option<f64> {
+    let mut mean = metrics::aggregate::PerObjectMean::new();
+    for r in ceiling.iter().filter(|r| curves.iter().any(|c| c.object == r.object)) {
+        if let Some(s) = r.metric(MetricKind::Psnr) {
+            mean.push(&r.object, s.clone());
+        }
+    }
+    if mean.per_object().is_empty() { None } else { mean.overall().value() }
 }
 
 fn load_exr(path: &Path) -> Result<metrics::Image> {

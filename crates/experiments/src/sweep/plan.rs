@@ -94,12 +94,7 @@ pub fn purely_neural() -> [ModelKind; 5] {
     ]
 }
 
-fn with_options(
-    base: &RunConfig,
-    kind: ModelKind,
-    o: RunOptions,
-    iterations: Option<u64>,
-) -> Result<RunConfig> {
+fn with_options(base: &RunConfig, kind: ModelKind, o: RunOptions) -> Result<RunConfig> {
     let mut c = base.clone();
     let model = &mut c.model;
     model.kind = kind;
@@ -108,11 +103,6 @@ fn with_options(
     model.nol = o.nol;
     model.albedo_clamp = o.albedo_clamp;
     model.scalar_specular = o.scalar_specular;
-    if let Some(n) = iterations {
-        c.train.iterations = n;
-        c.train.checkpoint_every = c.train.checkpoint_every.min(n);
-        c.train.warmup_steps = c.train.warmup_steps.min(n / 4);
-    }
     c.model.spatial_dim = c.spatial_dim();
     c.validate()?;
     Ok(c)
@@ -140,9 +130,21 @@ pub fn runs(profile: &SweepProfile) -> Result<Vec<RunSpec>> {
     let neural: Vec<ModelKind> =
         purely_neural().into_iter().filter(|k| models.contains(k)).collect();
     let additive: Vec<ModelKind> = neural.iter().copied().filter(|k| k.is_additive()).collect();
+    // The run-time curve: the Table 1 runs on its scene keep snapshots (the plateau schedule
+    // does not depend on the budget, so a snapshot is what a shorter run would have given).
+    let curve_scene = profile.sweep.runtime_curve.then_some(profile.sweep.runtime_scene);
+    let mut with_curve = base.clone();
+    with_curve.train.snapshots = true;
+    let curve_models = if models.is_empty() { ModelKind::ALL.to_vec() } else { models.clone() };
     for scene in 0..n_scenes {
+        let table_base = if curve_scene == Some(scene) { &with_curve } else { &base };
         for &kind in &models {
-            push(scene, Purpose::Table, with_options(&base, kind, d, None)?);
+            push(scene, Purpose::Table, with_options(table_base, kind, d)?);
+        }
+        if curve_scene == Some(scene) {
+            for &kind in &curve_models {
+                push(scene, Purpose::Runtime, with_options(table_base, kind, d)?);
+            }
         }
         for ablation in profile.ablations()? {
             let variants: Vec<(ModelKind, RunOptions)> = match ablation {
@@ -177,24 +179,8 @@ pub fn runs(profile: &SweepProfile) -> Result<Vec<RunSpec>> {
             };
             for (kind, o) in variants {
                 // The ablation's baseline is the Table 1 run of the same model.
-                push(scene, Purpose::Table, with_options(&base, kind, d, None)?);
-                push(scene, Purpose::Ablation, with_options(&base, kind, o, None)?);
-            }
-        }
-    }
-    if !profile.sweep.runtime_budgets.is_empty() {
-        let kinds = if profile.sweep.models.is_empty() {
-            ModelKind::ALL.to_vec()
-        } else {
-            profile.models()?
-        };
-        for kind in kinds {
-            for &b in &profile.sweep.runtime_budgets {
-                push(
-                    profile.sweep.runtime_scene,
-                    Purpose::Runtime,
-                    with_options(&base, kind, d, Some(b))?,
-                );
+                push(scene, Purpose::Table, with_options(table_base, kind, d)?);
+                push(scene, Purpose::Ablation, with_options(&base, kind, o)?);
             }
         }
     }
@@ -251,17 +237,25 @@ mod tests {
         let quick = SweepProfile::load("quick").unwrap();
         let r = runs(&quick).unwrap();
         assert_eq!(r.len(), 27, "9 models x 3 scenes");
+        let default = SweepProfile::load("default").unwrap();
+        let d = runs(&default).unwrap();
+        assert_eq!(d.len(), 27, "the run-time curve reuses the Table 1 runs of scene 0");
+        let curve: Vec<&RunSpec> =
+            d.iter().filter(|r| r.purposes.contains(&Purpose::Runtime)).collect();
+        assert_eq!(curve.len(), 9);
+        assert!(curve.iter().all(|r| r.scene == 0 && r.config.train.snapshots));
+        assert!(curve.iter().all(|r| r.purposes.contains(&Purpose::Table)));
         let smoke = SweepProfile::load("smoke").unwrap();
         let r = runs(&smoke).unwrap();
-        // Per scene: 9 Table 1 runs, 5 NOL, 10 reciprocity, 5 angle, 8 NeRFactor ablations;
-        // the run-time curve adds 9 x 2 budgets on scene 0.
-        assert_eq!(r.len(), 2 * (9 + 5 + 10 + 5 + 8) + 18);
+        // Per scene: 9 Table 1 runs, 5 NOL, 10 reciprocity, 5 angle, 8 NeRFactor ablations.
+        assert_eq!(r.len(), 2 * (9 + 5 + 10 + 5 + 8));
         let runtime = SweepProfile::load("runtime").unwrap();
         let rt = runs(&runtime).unwrap();
-        assert_eq!(rt.len(), 36);
-        // The 400-step curve point equals the quick profile's Table 1 run on that scene.
-        let q0 = &runs(&quick).unwrap()[0];
-        assert!(rt.iter().any(|r| r.config == q0.config), "shared by content address");
+        assert_eq!(rt.len(), 9);
+        // The runtime profile's runs are the default profile's curve runs.
+        for r in &rt {
+            assert!(curve.iter().any(|c| c.config == r.config), "shared by content address");
+        }
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! Sweep profiles: which scenes, models, ablations and training budgets a reproduction runs.
 //!
 //! A profile is a TOML file. The built-in ones live in `crates/experiments/profiles/` and are
-//! compiled in (`default`, `smoke`, `quick`, `full`); `--profile` takes one of those names or
+//! compiled in (`default`, `smoke`, `quick`, `runtime`, `full`); `--profile` takes one of those names or
 //! a path to a file of the same shape:
 //!
 //! ```toml
@@ -24,7 +24,7 @@
 //! [sweep]
 //! models = ["all"]                # Table 1 rows (paper names or config names)
 //! ablations = ["nol", "reciprocity", "angles", "nerfactor"]
-//! runtime_budgets = [250, 500, 1000, 2000]   # steps; empty: no run-time curve
+//! runtime_curve = true            # snapshots of the Table 1 runs on one scene, each scored
 //! runtime_scene = 0               # which scene the curve runs on
 //! ```
 //!
@@ -36,16 +36,18 @@ use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
 /// The built-in profiles: (name, TOML text).
-pub const BUILT_IN: [(&str, &str); 4] = [
+pub const BUILT_IN: [(&str, &str); 5] = [
+    ("default", include_str!("../../profiles/default.toml")),
     ("smoke", include_str!("../../profiles/smoke.toml")),
     ("quick", include_str!("../../profiles/quick.toml")),
     ("runtime", include_str!("../../profiles/runtime.toml")),
     ("full", include_str!("../../profiles/full.toml")),
 ];
 
-/// The profile `reproduce-tables` runs without `--profile`: the quick one, which needs no
-/// download (its mesh ships with the repository).
-pub const DEFAULT_PROFILE: &str = "quick";
+/// The profile `reproduce-tables` runs without `--profile`: Table 1 with every run trained to
+/// its plateau on three scenes of the shipped Spot mesh (no download), and the run-time curve
+/// of the first scene.
+pub const DEFAULT_PROFILE: &str = "default";
 
 /// The scenes of a profile.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
@@ -92,8 +94,10 @@ pub struct SweepSection {
     pub models: Vec<String>,
     /// Ablation groups: `nol`, `reciprocity`, `angles`, `nerfactor`.
     pub ablations: Vec<String>,
-    /// Training budgets (steps) of the run-time curve.
-    pub runtime_budgets: Vec<u64>,
+    /// Record the run-time curve: the Table 1 runs on `runtime_scene` keep weight snapshots
+    /// (`train.snapshots`) and `eval` scores each of them (all nine models when `models` is
+    /// empty).
+    pub runtime_curve: bool,
     /// Index of the scene the curve runs on.
     pub runtime_scene: usize,
 }
@@ -199,11 +203,7 @@ impl SweepProfile {
         }
         self.models()?;
         self.ablations()?;
-        if self.sweep.runtime_budgets.contains(&0) {
-            return bad("sweep.runtime_budgets", "a budget of 0 steps".into());
-        }
-        if !self.sweep.runtime_budgets.is_empty() && self.sweep.runtime_scene >= self.scene_count()
-        {
+        if self.sweep.runtime_curve && self.sweep.runtime_scene >= self.scene_count() {
             return bad(
                 "sweep.runtime_scene",
                 format!("{} but there are {} scenes", self.sweep.runtime_scene, self.scene_count()),
@@ -315,11 +315,13 @@ mod tests {
             let p = SweepProfile::load(name).unwrap();
             assert_eq!(p.name, name);
             assert!(p.scene_count() >= 1);
-            assert!(!p.models().unwrap().is_empty() || !p.sweep.runtime_budgets.is_empty());
+            assert!(!p.models().unwrap().is_empty() || p.sweep.runtime_curve);
         }
-        let quick = SweepProfile::load("quick").unwrap();
-        assert_eq!(quick.models().unwrap().len(), 9);
-        assert_eq!(quick.scene_count(), 3);
+        for name in ["default", "quick"] {
+            let p = SweepProfile::load(name).unwrap();
+            assert_eq!(p.models().unwrap().len(), 9);
+            assert_eq!(p.scene_count(), 3);
+        }
     }
 
     #[test]
