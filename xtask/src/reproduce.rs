@@ -76,9 +76,10 @@ pub fn reproduce(opts: Options) -> Result<()> {
 }
 
 fn print_results(out: &Path, files: &[PathBuf]) {
-    let t1 = out.join("tables/table1.md");
-    if let Ok(text) = std::fs::read_to_string(&t1) {
-        println!("{text}");
+    for table in ["table1", "runtime"] {
+        if let Ok(text) = std::fs::read_to_string(out.join(format!("tables/{table}.md"))) {
+            println!("{text}");
+        }
     }
     eprintln!("tables and figures ({} files) in {}:", files.len(), out.display());
     for f in files {

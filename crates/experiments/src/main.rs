@@ -121,9 +121,19 @@ fn main() -> Result<()> {
                     if resumed_from > 0 {
                         println!("resumed from step {resumed_from}");
                     }
+                    let why = match m.stop_reason {
+                        Some(experiments::plateau::StopReason::Plateau) => "converged",
+                        _ => "step budget reached",
+                    };
+                    let val = match (m.best_val_loss, m.val_loss_floor) {
+                        (Some(v), Some(f)) => format!(", validation {v:.4e} (noise floor {f:.4e})"),
+                        (Some(v), None) => format!(", validation {v:.4e}"),
+                        _ => String::new(),
+                    };
                     println!(
-                        "{}: {} steps in {:.1} s, {:.0} samples/s, final loss {:.4e}",
+                        "{}: {} after {} steps in {:.1} s, {:.0} samples/s, final loss {:.4e}{val}",
                         out.display(),
+                        why,
                         m.steps,
                         m.wall_seconds,
                         m.samples_per_second,

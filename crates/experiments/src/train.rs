@@ -188,7 +188,7 @@ pub fn fit(config: &RunConfig, run: &Path, options: FitOptions) -> Result<FitOut
     let end =
         lp.run(model, &mut optim, state, last_checkpoint, options.hook, options.stop_after)?;
     let (model, state) = match end {
-        LoopEnd::Done(model, state) => (model, state),
+        LoopEnd::Done(done) => *done,
         LoopEnd::Interrupted(step) => return Ok(FitOutcome::Stopped(step)),
     };
     lp.bar.finish_with_message(if state.stopped.is_some_and(|r| r.converged()) {

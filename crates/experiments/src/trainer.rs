@@ -31,7 +31,7 @@ pub type StepHook = Box<dyn FnMut(u64, BrdfModel) -> BrdfModel>;
 /// How the loop ended.
 pub(crate) enum LoopEnd {
     /// Training is over (plateau or budget); the state says which.
-    Done(BrdfModel, CheckpointState),
+    Done(Box<(BrdfModel, CheckpointState)>),
     /// Interrupted on request after this many steps (a checkpoint was written).
     Interrupted(u64),
 }
@@ -113,7 +113,7 @@ impl Loop<'_> {
                 return Ok(LoopEnd::Interrupted(state.step));
             }
         }
-        Ok(LoopEnd::Done(model, state))
+        Ok(LoopEnd::Done(Box::new((model, state))))
     }
 
     /// One optimiser step at rate `lr`: the batch of `step`, the loss, its gradient, Adam.
