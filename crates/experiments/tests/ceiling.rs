@@ -35,7 +35,13 @@ fn the_ground_truth_scores_the_noise_ceiling_exactly() {
     let data = TrainingData::new(&samples, &[], 0);
     assert!(!data.is_empty());
     let gt: Vec<[f32; 3]> = data.source.iter().map(|&i| samples.gt_brdf[i]).collect();
-    let opts = RenderOptions { run: &dir.0, write: false, lpips: None, progress: false };
+    let opts = RenderOptions {
+        run: &dir.0,
+        write: false,
+        lpips: None,
+        progress: false,
+        skip_ceiling: false,
+    };
     let score = |f: Vec<[f32; 3]>| {
         let pred = Prediction { f, ..Default::default() };
         render_and_score(&scene, &samples, &data, &pred, &opts).unwrap()

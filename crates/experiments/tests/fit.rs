@@ -104,6 +104,7 @@ fn loss_values(run: &Path) -> Vec<f32> {
 fn models_fit_the_scene_and_eval_scores_them() {
     let dir = TempDir::new("fit");
     let eval = "[eval]\nenergy_pairs = 64\nreciprocity_pairs = 500\n";
+    let mut ceilings_seen = None;
     for kind in ["single_mlp", "disney", "additive_shared_enhanced"] {
         let run = dir.0.join(kind);
         let out = fit(&config(kind, 300, eval), &run, FitOptions::default()).unwrap();
@@ -129,6 +130,13 @@ fn models_fit_the_scene_and_eval_scores_them() {
         assert!(test.images == 4 && test.psnr.is_finite() && test.psnr > 15.0, "{kind}: {test:?}");
         assert!(test.flip.is_finite() && test.dssim.is_finite(), "{kind}: {test:?}");
         assert!(test.rmse_cbrt.is_some_and(f64::is_finite) && test.rmse_samples > 0);
+        // A semi-synthetic scene: the noise ceiling and the scores against the noise-free
+        // renders are there; the ceiling is the same for every model (cached per scene after
+        // the first evaluation, identical when recomputed).
+        let ceiling = test.ceiling.clone().expect("noise ceiling");
+        assert!(test.clean.as_ref().is_some_and(|c| c.psnr > test.psnr), "{kind}: {test:?}");
+        let ceilings = ceilings_seen.get_or_insert_with(|| ceiling.clone());
+        assert_eq!(*ceilings, ceiling, "{kind}");
         // No LPIPS weights on this machine: absent, with the reason.
         if test.lpips.is_none() {
             assert_eq!(test.lpips_unavailable.as_deref(), Some("weights missing"));

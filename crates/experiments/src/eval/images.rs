@@ -161,6 +161,9 @@ pub struct RenderOptions<'a> {
     pub lpips: Option<&'a Lpips>,
     /// Show a progress bar.
     pub progress: bool,
+    /// Skip the noise ceiling (already known for this scene): [`ImageScores::ceiling`] is then
+    /// `None`.
+    pub skip_ceiling: bool,
 }
 
 /// The clip level renders get: the saturation of semi-synthetic scenes, none for captures
@@ -201,8 +204,10 @@ pub fn render_and_score(
             let noise_free = to_image(w, h, &noise_free)?;
             let (c, _) = score(&test, &noise_free, &mask, opts.lpips, exposures)?;
             clean.get_or_insert_with(ImageMetrics::default).add(&c);
-            let (g, _) = score(&noise_free, &observed, &mask, opts.lpips, exposures)?;
-            ceiling.get_or_insert_with(ImageMetrics::default).add(&g);
+            if !opts.skip_ceiling {
+                let (g, _) = score(&noise_free, &observed, &mask, opts.lpips, exposures)?;
+                ceiling.get_or_insert_with(ImageMetrics::default).add(&g);
+            }
         }
         if let Some(out) = &out {
             let stem = format!("view{vi:03}_light{li:03}");

@@ -135,6 +135,34 @@ pub fn cube_root_rmse(
     Ok((value, rmse.kept))
 }
 
+/// The noise ceiling of a scene, computed by the first evaluation of a run on it and kept in
+/// the cache directory: `ceiling-<key>.json`, the key hashing the scene's manifest checksum,
+/// whether LPIPS was scored and the code's results version.
+struct CeilingCache(std::path::PathBuf);
+
+impl CeilingCache {
+    fn new(cache: &Path, scene: &dataset_merl::SceneDataset, lpips: bool) -> Self {
+        let key = format!(
+            "{}\n{lpips}\n{}",
+            scene.manifest.checksum,
+            crate::sweep::plan::CODE_VERSION
+        );
+        let hash = xxhash_rust::xxh3::xxh3_64(key.as_bytes());
+        CeilingCache(cache.join(format!("ceiling-{hash:016x}.json")))
+    }
+
+    /// The cached ceiling; a missing or unreadable file is a miss (it is recomputed).
+    fn read(&self) -> Option<ImageMetrics> {
+        serde_json::from_str(&std::fs::read_to_string(&self.0).ok()?).ok()
+    }
+
+    fn write(&self, ceiling: &ImageMetrics) -> Result<()> {
+        let text = serde_json::to_string_pretty(ceiling)
+            .map_err(|e| crate::Error::format(&self.0, e.to_string()))?;
+        crate::run_dir::write_atomic(&self.0, text.as_bytes())
+    }
+}
+
 /// Test PSNR and cube-root RMSE of every weight snapshot of the run.
 fn snapshot_curve(
     fitted: &FittedRun,
@@ -175,9 +203,21 @@ pub fn eval(
     } else {
         (None, Some("weights missing".to_string()))
     };
-    let opts =
-        images::RenderOptions { run, write: settings.images, lpips: lpips.as_ref(), progress };
-    let scores = images::render_and_score(dataset, &samples, &data, &pred, &opts)?;
+    let cached = CeilingCache::new(&fitted.cache, dataset, lpips.is_some());
+    let known = cached.read();
+    let opts = images::RenderOptions {
+        run,
+        write: settings.images,
+        lpips: lpips.as_ref(),
+        progress,
+        skip_ceiling: known.is_some(),
+    };
+    let mut scores = images::render_and_score(dataset, &samples, &data, &pred, &opts)?;
+    match (&known, &scores.ceiling) {
+        (Some(c), _) => scores.ceiling = Some(c.clone()),
+        (None, Some(c)) => cached.write(c)?,
+        (None, None) => {}
+    }
     let brdf = ModelBrdf { model, config: &config.model, data: &data, device };
     let reciprocity_rmse = analyses::reciprocity(&brdf, &settings)?;
     let energy = analyses::energy(&brdf, &settings, config.seed, progress)?;
