@@ -51,7 +51,7 @@
 //! `quick` decays once (1e-3 to 1e-4) and stops at the next plateau: the default profile's
 //! rule, sized so that Table 1's 27 runs fit this 2-core machine's hour. `cpu` is the patient
 //! rule the `runtime` profile measures plateaus with (three decays by 4, 0.5 % threshold over
-//! 600 steps). //! `docs/reproduce.md` gives the measurements that chose these values. The regulariser
+//! 600 steps). `docs/reproduce.md` gives the measurements that chose these values. The regulariser
 //! weights are the paper's (enhanced split, spec 4.5) and apply to the enhanced additive
 //! models only. `output_init = "data"` starts every model's output layer at the
 //! least-squares constant BRDF of the training records ([`crate::data::TrainingData::mean_brdf`]),

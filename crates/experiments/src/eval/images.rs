@@ -41,6 +41,7 @@ use dataset_merl::{SampleSet, SceneDataset};
 use indicatif::{ProgressBar, ProgressStyle};
 use metrics::Image;
 use metrics::lpips::Lpips;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -186,27 +187,26 @@ pub fn render_and_score(
     let (w, h) = (t.width, t.height);
     let out = OutputDirs::new(opts.run, opts.write)?;
     let bar = progress_bar(t.pairs.len(), opts.progress);
-    let (mut model, mut clean, mut ceiling) = (ImageMetrics::default(), None, None);
-    let mut albedo = AlbedoMaps::default();
-    for &(vi, li) in &t.pairs {
+    // One test image per task: rendering, the (up to three) scores and the image files are
+    // independent across pairs, and FLIP dominates the cost.
+    let score_pair = |&(vi, li): &(usize, usize)| -> Result<PairScores> {
         let records = t.records(vi, li);
         let render = |part: &[[f32; 3]]| t.render(records, part);
         let img = render(&pred.f);
         let mask = t.mask(vi);
         let test = to_image(w, h, &img)?;
         let observed = to_image(w, h, &dataset.observed_image(vi, li)?)?;
-        let (m, flip) = score(&test, &observed, &mask, opts.lpips, None)?;
-        model.add(&m);
+        let (model, flip) = score(&test, &observed, &mask, opts.lpips, None)?;
+        let mut scores = PairScores { model, clean: None, ceiling: None };
         if let Some(noise_free) = dataset.clean_image(vi, li)? {
             // The three scores of a test image share the observed image's FLIP exposures (a
             // noise-free image can be black where every lit pixel faces away).
             let exposures = Some((flip.start_exposure, flip.stop_exposure));
             let noise_free = to_image(w, h, &noise_free)?;
-            let (c, _) = score(&test, &noise_free, &mask, opts.lpips, exposures)?;
-            clean.get_or_insert_with(ImageMetrics::default).add(&c);
+            scores.clean = Some(score(&test, &noise_free, &mask, opts.lpips, exposures)?.0);
             if !opts.skip_ceiling {
-                let (g, _) = score(&noise_free, &observed, &mask, opts.lpips, exposures)?;
-                ceiling.get_or_insert_with(ImageMetrics::default).add(&g);
+                scores.ceiling =
+                    Some(score(&noise_free, &observed, &mask, opts.lpips, exposures)?.0);
             }
         }
         if let Some(out) = &out {
@@ -218,18 +218,33 @@ pub fn render_and_score(
                     write_png_srgb(&path, w as u32, h as u32, &render(part))?;
                 }
             }
-            if let Some(fd) = &pred.diffuse_raw {
-                albedo.add(
-                    vi,
-                    w * h,
-                    records.iter().map(|&r| (samples.pixel[data.source[r]], fd[r])),
-                );
-            }
         }
         bar.inc(1);
-    }
+        Ok(scores)
+    };
+    let per_pair: Vec<PairScores> = if opts.lpips.is_some() {
+        // The LPIPS network runs its own threads; one image at a time.
+        t.pairs.iter().map(score_pair).collect::<Result<_>>()?
+    } else {
+        t.pairs.par_iter().map(score_pair).collect::<Result<_>>()?
+    };
     bar.finish_and_clear();
-    if let Some(out) = &out {
+    let (mut model, mut clean, mut ceiling) = (ImageMetrics::default(), None, None);
+    for s in &per_pair {
+        model.add(&s.model);
+        if let Some(c) = &s.clean {
+            clean.get_or_insert_with(ImageMetrics::default).add(c);
+        }
+        if let Some(g) = &s.ceiling {
+            ceiling.get_or_insert_with(ImageMetrics::default).add(g);
+        }
+    }
+    if let (Some(out), Some(fd)) = (&out, &pred.diffuse_raw) {
+        let mut albedo = AlbedoMaps::default();
+        for &(vi, li) in &t.pairs {
+            let records = t.records(vi, li);
+            albedo.add(vi, w * h, records.iter().map(|&r| (samples.pixel[data.source[r]], fd[r])));
+        }
         albedo.write(&out.albedo, (w, h))?;
     }
     let n = t.pairs.len();
@@ -241,6 +256,13 @@ pub fn render_and_score(
     })
 }
 
+/// The scores of one test image.
+struct PairScores {
+    model: ImageMetrics,
+    clean: Option<ImageMetrics>,
+    ceiling: Option<ImageMetrics>,
+}
+
 /// The mean PSNR of the renders of `f` (one BRDF value per record of `data`) against the
 /// observed test images: the cheap score of the run-time curve's snapshots.
 pub fn mean_psnr(
@@ -250,13 +272,16 @@ pub fn mean_psnr(
     f: &[[f32; 3]],
 ) -> Result<f64> {
     let t = TestImages::new(dataset, samples, data);
-    let mut sum = 0.0;
-    for &(vi, li) in &t.pairs {
-        let test = to_image(t.width, t.height, &t.render(t.records(vi, li), f))?;
-        let observed = to_image(t.width, t.height, &dataset.observed_image(vi, li)?)?;
-        sum += metrics::psnr_linear(&test, &observed, Some(&t.mask(vi)))?;
-    }
-    Ok(sum / t.pairs.len().max(1) as f64)
+    let psnr: Vec<f64> = t
+        .pairs
+        .par_iter()
+        .map(|&(vi, li)| {
+            let test = to_image(t.width, t.height, &t.render(t.records(vi, li), f))?;
+            let observed = to_image(t.width, t.height, &dataset.observed_image(vi, li)?)?;
+            Ok(metrics::psnr_linear(&test, &observed, Some(&t.mask(vi)))?)
+        })
+        .collect::<Result<_>>()?;
+    Ok(psnr.iter().sum::<f64>() / t.pairs.len().max(1) as f64)
 }
 
 /// The test pairs of a scene and their records, for rendering.

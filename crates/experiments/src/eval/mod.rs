@@ -142,11 +142,8 @@ struct CeilingCache(std::path::PathBuf);
 
 impl CeilingCache {
     fn new(cache: &Path, scene: &dataset_merl::SceneDataset, lpips: bool) -> Self {
-        let key = format!(
-            "{}\n{lpips}\n{}",
-            scene.manifest.checksum,
-            crate::sweep::plan::CODE_VERSION
-        );
+        let key =
+            format!("{}\n{lpips}\n{}", scene.manifest.checksum, crate::sweep::plan::CODE_VERSION);
         let hash = xxhash_rust::xxh3::xxh3_64(key.as_bytes());
         CeilingCache(cache.join(format!("ceiling-{hash:016x}.json")))
     }
