@@ -72,13 +72,15 @@ impl Plateau {
             self.since = step;
             return Decision::Continue;
         }
-        if t.schedule != Schedule::Plateau || step - self.since < t.patience {
-            return Decision::Continue;
-        }
         let next = self.lr_scale * t.lr_decay;
         // The floor is compared with a little slack, so that a floor chosen as an exact power
         // of the decay factor is reached rather than missed by rounding.
-        if t.learning_rate * next < t.lr_final * (1.0 - 1e-9) {
+        let at_floor = t.learning_rate * next < t.lr_final * (1.0 - 1e-9);
+        let patience = if at_floor { t.final_patience.unwrap_or(t.patience) } else { t.patience };
+        if t.schedule != Schedule::Plateau || step - self.since < patience {
+            return Decision::Continue;
+        }
+        if at_floor {
             return Decision::Stop;
         }
         self.lr_scale = next;
@@ -138,6 +140,24 @@ mod tests {
         // Falls by 0.1 % per validation: below the 1 % threshold, so it is a plateau.
         let (stop, _) = run((0..1000).map(|i| 0.999f64.powi(i)));
         assert!(stop.is_some());
+    }
+
+    #[test]
+    fn final_patience_shortens_only_the_last_plateau() {
+        let t = TrainConfig { final_patience: Some(10), ..config() };
+        let mut p = Plateau::default();
+        let mut stop = None;
+        for i in 0..100u64 {
+            let step = 10 * (i + 1);
+            if p.update(step, 0.5, &t) == Decision::Stop {
+                stop = Some(step);
+                break;
+            }
+        }
+        // Three decays 30 steps apart as before, then the stop 10 steps after the last.
+        assert_eq!((stop, p.decays), (Some(10 + 3 * 30 + 10), 3));
+        let bad = TrainConfig { final_patience: Some(5), ..config() };
+        assert!(bad.validate().unwrap_err().to_string().contains("train.final_patience"));
     }
 
     #[test]

@@ -41,6 +41,7 @@
 //! | `validate_every` | 100 | 100 | 250 |
 //! | `validation_records` | 32,768 | 32,768 | 262,144 |
 //! | `patience` | 300 | 600 | 5,000 |
+//! | `final_patience` | = patience | = patience | = patience |
 //! | `min_improvement` | 0.01 | 0.005 | 0.002 |
 //! | `lr_decay` | 0.1 | 0.25 | 0.25 |
 //! | `checkpoint_every` | 1,000 | 2,000 | 5,000 |
@@ -116,6 +117,7 @@ struct RawTrain {
     validate_every: Option<u64>,
     validation_records: Option<usize>,
     patience: Option<u64>,
+    final_patience: Option<u64>,
     min_improvement: Option<f64>,
     lr_decay: Option<f64>,
     checkpoint_every: Option<u64>,
@@ -156,6 +158,11 @@ pub struct TrainConfig {
     pub validation_records: usize,
     /// Plateau schedule: steps without improvement before the rate decays (or the run stops).
     pub patience: u64,
+    /// Plateau schedule: the patience once the rate is at its smallest (only the stop is
+    /// left to decide); `None`: `patience`. Not serialised when `None`, so existing run ids
+    /// are unchanged.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub final_patience: Option<u64>,
     /// Plateau schedule: relative decrease of the validation loss that counts as improvement.
     pub min_improvement: f64,
     /// Plateau schedule: factor on the rate at each plateau.
@@ -190,6 +197,7 @@ impl TrainConfig {
             validate_every: 100,
             validation_records: 32_768,
             patience: 300,
+            final_patience: None,
             min_improvement: 0.01,
             lr_decay: 0.1,
             checkpoint_every: 1_000,
@@ -324,11 +332,16 @@ impl TrainConfig {
                     "the plateau schedule needs a validation split (> 0)",
                 ));
             }
-            if self.patience < self.validate_every {
-                return Err(Error::config(
-                    "train.patience",
-                    format!("must be at least validate_every = {}", self.validate_every),
-                ));
+            for (key, p) in [
+                ("train.patience", Some(self.patience)),
+                ("train.final_patience", self.final_patience),
+            ] {
+                if p.is_some_and(|p| p < self.validate_every) {
+                    return Err(Error::config(
+                        key,
+                        format!("must be at least validate_every = {}", self.validate_every),
+                    ));
+                }
             }
             if self.lr_final > self.learning_rate {
                 return Err(Error::config(
@@ -367,6 +380,7 @@ impl<'de> Deserialize<'de> for TrainConfig {
             validate_every: r.validate_every.unwrap_or(p.validate_every),
             validation_records: r.validation_records.unwrap_or(p.validation_records),
             patience: r.patience.unwrap_or(p.patience),
+            final_patience: r.final_patience.or(p.final_patience),
             min_improvement: r.min_improvement.unwrap_or(p.min_improvement),
             lr_decay: r.lr_decay.unwrap_or(p.lr_decay),
             checkpoint_every: r.checkpoint_every.unwrap_or(p.checkpoint_every),
