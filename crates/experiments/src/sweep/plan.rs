@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 /// The version of the code that results depend on: bump it with any change that alters a
 /// result (training, models, data generation or metrics), so that content-addressed runs of
 /// the old code are not reused.
-pub const CODE_VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), "+results-2");
+pub const CODE_VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), "+results-3");
 
 /// Why a run is in the sweep.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
