@@ -101,6 +101,7 @@ mod tests {
             lr_decay: 0.5,
             validate_every: 10,
             patience: 30,
+            final_patience: None,
             min_improvement: 0.01,
             ..TrainConfig::default()
         }
