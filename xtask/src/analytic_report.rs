@@ -3,12 +3,11 @@
 //! standard error), reciprocity error and evaluation speed. Written as Markdown to stdout and,
 //! atomically, to a file.
 
-use anyhow::{Context, Result};
-use brdf_analytic::albedo::{SplitMix64, cosine_sample, directional_albedo};
+use brdf_analytic::albedo::{cosine_sample, directional_albedo};
 use brdf_analytic::*;
 use std::fmt::Write as _;
-use std::path::Path;
 use std::time::Instant;
+use stdx::rng::SplitMix64;
 
 /// Options of the report.
 pub struct Options {
@@ -109,20 +108,4 @@ pub fn report(opts: &Options) -> String {
         let _ = writeln!(md, "| {} | {rel:.3e} | {:.1} M |", m.name(), rate / 1e6);
     }
     md
-}
-
-/// Writes `contents` to `path` atomically: a temporary file in the same directory, then rename.
-pub fn write_atomic(path: &Path, contents: &str) -> Result<()> {
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("creating directory {}", dir.display()))?;
-    let tmp = dir.join(format!(
-        ".{}.tmp{}",
-        path.file_name().and_then(|n| n.to_str()).unwrap_or("out"),
-        std::process::id()
-    ));
-    std::fs::write(&tmp, contents).with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, path)
-        .with_context(|| format!("renaming {} to {}", tmp.display(), path.display()))?;
-    Ok(())
 }

@@ -9,6 +9,7 @@ mod analytic_report;
 mod fetch;
 mod generate_scenes;
 mod import_diligent;
+mod layers;
 mod reproduce;
 
 use anyhow::Result;
@@ -163,7 +164,7 @@ fn main() -> Result<()> {
             anyhow::ensure!(pairs >= 1, "--pairs must be at least 1 (got {pairs})");
             let md = analytic_report::report(&analytic_report::Options { samples, pairs, seed });
             print!("{md}");
-            analytic_report::write_atomic(&out, &md)?;
+            stdx::fs::write_atomic(&out, md.as_bytes())?;
             eprintln!("report written to {}", out.display());
         }
         Command::GenerateScenes { meshes, materials, seed, size, views, lights, merl_dir, out } => {
@@ -196,24 +197,10 @@ fn main() -> Result<()> {
             import_diligent::run(&src, &out, train_lights, test_lights, target_vertices)?;
         }
         Command::Layers => {
-            for c in LAYERS {
+            for c in layers::layers() {
                 println!("{c}");
             }
         }
     }
     Ok(())
 }
-
-/// The workspace crates, bottom first: a crate may depend only on crates before it.
-pub const LAYERS: &[&str] = &[
-    "angles",
-    "brdf-analytic",
-    "mesh-encoding",
-    "raycast-precompute",
-    "dataset-merl",
-    "dataset-diligent",
-    "metrics",
-    "brdf-neural",
-    "experiments",
-    "xtask",
-];

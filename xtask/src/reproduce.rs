@@ -2,6 +2,7 @@
 //! command (see `experiments::sweep` for the profiles, the run layout and the tables).
 
 use anyhow::{Context, Result};
+use experiments::run_dir::SweepLayout;
 use experiments::sweep::{self, Execution, SweepProfile};
 use std::path::{Path, PathBuf};
 
@@ -60,11 +61,11 @@ pub fn reproduce(opts: Options) -> Result<()> {
             s.emitted,
             file.display(),
             file.display(),
-            opts.out.join("runs").display()
+            SweepLayout::new(&opts.out).runs().display()
         );
         return Ok(());
     }
-    let c = sweep::collect(&[opts.out.join("runs")], &opts.out, &profile.name)?;
+    let c = sweep::collect(&[SweepLayout::new(&opts.out).runs()], &opts.out, &profile.name)?;
     eprintln!("{} run(s) collected in {:.1} min", c.runs, s.seconds / 60.0);
     print_results(&opts.out, &c.files);
     anyhow::ensure!(
@@ -77,7 +78,8 @@ pub fn reproduce(opts: Options) -> Result<()> {
 
 fn print_results(out: &Path, files: &[PathBuf]) {
     for table in ["table1", "runtime"] {
-        if let Ok(text) = std::fs::read_to_string(out.join(format!("tables/{table}.md"))) {
+        let path = SweepLayout::new(out).tables().join(format!("{table}.md"));
+        if let Ok(text) = std::fs::read_to_string(path) {
             println!("{text}");
         }
     }

@@ -153,15 +153,18 @@ fn serve(mut c: TcpStream, state: &Mutex<State>) -> std::io::Result<()> {
     c.shutdown(std::net::Shutdown::Both)
 }
 
-/// A per-test scratch directory with `manifests/` and `data/`.
-struct Scratch(PathBuf);
+/// A per-test scratch directory with `manifests/` and `data/`, removed on drop.
+struct Scratch(
+    PathBuf,
+    #[expect(dead_code, reason = "held for its Drop, which removes the directory")]
+    test_support::TempDir,
+);
 
 impl Scratch {
     fn new(tag: &str) -> Scratch {
-        let d = std::env::temp_dir().join(format!("xtask-fetch-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(d.join("manifests")).unwrap();
-        Scratch(d)
+        let tmp = test_support::TempDir::new(&format!("fetch-{tag}"));
+        std::fs::create_dir_all(tmp.0.join("manifests")).unwrap();
+        Scratch(tmp.0.clone(), tmp)
     }
     fn data(&self) -> PathBuf {
         self.0.join("data")
@@ -179,12 +182,6 @@ impl Scratch {
         cmd.arg("fetch-data").arg("--manifests").arg(self.0.join("manifests"));
         cmd.arg("--dest").arg(self.data()).args(args).env_remove("NEURAL_BRDF_DATA");
         cmd.output().unwrap()
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
     }
 }
 

@@ -1,22 +1,16 @@
-//! Architecture invariant: crates depend only downward in the layering
-//! `angles < brdf-analytic < mesh-encoding < raycast-precompute < dataset-merl < dataset-diligent <
-//! metrics < brdf-neural < experiments < xtask` (docs/ARCHITECTURE.md).
+//! Architecture invariant: crates depend only downward in the layering, which is written once:
+//! the order of the path entries of `[workspace.dependencies]` in the root Cargo.toml, printed by
+//! `cargo xtask layers` (docs/ARCHITECTURE.md).
 
 use serde_json::Value;
 use std::process::Command;
 
-const LAYERS: &[&str] = &[
-    "angles",
-    "brdf-analytic",
-    "mesh-encoding",
-    "raycast-precompute",
-    "dataset-merl",
-    "dataset-diligent",
-    "metrics",
-    "brdf-neural",
-    "experiments",
-    "xtask",
-];
+/// The layering as `cargo xtask layers` prints it (read from the root Cargo.toml).
+fn layers() -> Vec<String> {
+    let out = Command::new(env!("CARGO_BIN_EXE_xtask")).arg("layers").output().expect("run xtask");
+    assert!(out.status.success(), "xtask layers failed");
+    String::from_utf8(out.stdout).expect("UTF-8").lines().map(str::to_owned).collect()
+}
 
 fn metadata() -> Value {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
@@ -35,23 +29,24 @@ fn metadata() -> Value {
 
 #[test]
 fn dependencies_point_only_downward() {
+    let layers = layers();
     let meta = metadata();
     let packages = meta["packages"].as_array().expect("packages");
     let names: Vec<&str> = packages.iter().map(|p| p["name"].as_str().unwrap()).collect();
-    for layer in LAYERS {
-        assert!(names.contains(layer), "workspace member {layer} missing");
+    for layer in &layers {
+        assert!(names.contains(&layer.as_str()), "workspace member {layer} missing");
     }
     let mut violations = Vec::new();
     for p in packages {
         let name = p["name"].as_str().unwrap();
-        let rank = LAYERS.iter().position(|l| *l == name);
+        let rank = layers.iter().position(|l| l == name);
         let Some(rank) = rank else {
             violations.push(format!("{name} is not in the layering list"));
             continue;
         };
         for dep in p["dependencies"].as_array().unwrap() {
             let dep_name = dep["name"].as_str().unwrap();
-            if let Some(dep_rank) = LAYERS.iter().position(|l| *l == dep_name) {
+            if let Some(dep_rank) = layers.iter().position(|l| l == dep_name) {
                 // Dev-dependencies may not point up either: a test must not reach back.
                 if dep_rank >= rank {
                     violations.push(format!("{name} depends on {dep_name}, which is not below it"));
@@ -63,10 +58,13 @@ fn dependencies_point_only_downward() {
 }
 
 #[test]
-fn xtask_layers_match_this_list() {
-    // The CLI's list and this test's list are the same source of truth.
-    let src = include_str!("../src/main.rs");
-    for l in LAYERS {
-        assert!(src.contains(&format!("\"{l}\"")), "xtask LAYERS lacks {l}");
-    }
+fn every_member_is_in_the_layering_once() {
+    let layers = layers();
+    let meta = metadata();
+    let members = meta["packages"].as_array().expect("packages").len();
+    let mut unique = layers.clone();
+    unique.sort();
+    unique.dedup();
+    assert_eq!(unique.len(), layers.len(), "a crate listed twice: {layers:?}");
+    assert_eq!(layers.len(), members, "layering {layers:?} against {members} members");
 }

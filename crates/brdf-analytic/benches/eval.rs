@@ -4,10 +4,11 @@
 //! Run: `cargo bench -p brdf-analytic --bench eval`. Criterion prints "thrpt" in elements/s,
 //! one element being one BRDF evaluation (RGB).
 
-use brdf_analytic::albedo::{SplitMix64, cosine_sample};
+use brdf_analytic::albedo::cosine_sample;
 use brdf_analytic::*;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
+use stdx::rng::SplitMix64;
 
 const N: usize = 1 << 20;
 

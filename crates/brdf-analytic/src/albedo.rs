@@ -11,6 +11,7 @@
 
 use crate::brdf::Brdf;
 use angles::{Real, Vec3};
+use stdx::rng::SplitMix64;
 
 /// A Monte Carlo estimate per RGB channel.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,31 +28,6 @@ impl AlbedoEstimate {
     /// Whether every channel is at most `bound` within `sigmas` standard errors.
     pub fn at_most(&self, bound: f64, sigmas: f64) -> bool {
         (0..3).all(|c| self.mean[c] - sigmas * self.std_error[c] <= bound)
-    }
-}
-
-/// SplitMix64, a small, fast, well-mixed generator; enough for Monte Carlo estimates.
-#[derive(Clone, Debug)]
-pub struct SplitMix64(u64);
-
-impl SplitMix64 {
-    /// A generator from a seed.
-    pub fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-
-    /// Next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1) with 53 random bits.
-    pub fn next_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
     }
 }
 

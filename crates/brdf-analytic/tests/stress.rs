@@ -2,8 +2,8 @@
 //! f64, with parameters at both ends of their ranges. No NaN or Inf, never negative, and exactly
 //! zero outside the upper hemisphere.
 
-use brdf_analytic::albedo::SplitMix64;
 use brdf_analytic::*;
+use stdx::rng::SplitMix64;
 
 const PAIRS: usize = 1_000_000;
 

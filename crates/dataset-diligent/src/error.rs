@@ -68,3 +68,9 @@ impl Error {
         Self::Options { key: key.into(), fault: fault.into() }
     }
 }
+
+impl From<stdx::fs::Error> for Error {
+    fn from(e: stdx::fs::Error) -> Self {
+        Self::Io { path: e.path, source: e.source }
+    }
+}

@@ -181,10 +181,8 @@ pub fn import_multi_view(src: &Path, out: &Path, o: &MultiViewOptions) -> Result
     let loaded = mesh_encoding::load_mesh(&mesh_path, &mesh_encoding::LoadOptions::default())?;
     let (mut mesh, decimation) = match o.target_vertices {
         Some(target) if loaded.mesh.positions.len() > target => {
-            let bar = spinner(
-                o.progress,
-                format!("decimating {} to {target} vertices", mesh_path.display()),
-            );
+            let message = format!("decimating {} to {target} vertices", mesh_path.display());
+            let bar = stdx::progress::spinner(&message, o.progress);
             let (m, r) = decimate(
                 &loaded.mesh,
                 &DecimateOptions { target_vertices: target, ..Default::default() },
@@ -255,14 +253,4 @@ pub fn import_multi_view(src: &Path, out: &Path, o: &MultiViewOptions) -> Result
         normal_check: summarize(errs),
         warnings,
     })
-}
-
-fn spinner(progress: bool, msg: String) -> indicatif::ProgressBar {
-    if !progress {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = indicatif::ProgressBar::new_spinner();
-    bar.set_message(msg);
-    bar.enable_steady_tick(std::time::Duration::from_millis(200));
-    bar
 }

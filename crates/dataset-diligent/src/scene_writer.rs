@@ -20,7 +20,7 @@
 use crate::capture::{Capture, diligent_to_opencv};
 use crate::error::{Error, Result};
 use crate::report::ViewReport;
-use dataset_merl::scene::generate::{image_progress, sample_stem};
+use dataset_merl::scene::generate::sample_stem;
 use dataset_merl::scene::manifest::{
     FORMAT, FileEntry, LightInfo, MANIFEST_FILE, Manifest, SceneStats, Split, VERSION, ViewInfo,
 };
@@ -139,7 +139,7 @@ pub(crate) fn write_scene(s: &CapturedScene<'_>, out: &Path, progress: bool) -> 
     config.validate()?;
 
     let subdirs = ["images", "brdf", "flags", "masks", "previews"];
-    dataset_merl::atomic::write_dir_atomic(out, &subdirs, |tmp: &Path| {
+    stdx::fs::write_dir_atomic(out, &subdirs, |tmp: &Path| {
         assemble(s, &config, &views, infos, tmp, progress)
     })
 }
@@ -195,7 +195,7 @@ fn assemble(
         .flat_map(|(vi, v)| (0..v.lights.len()).map(move |li| (vi, li)))
         .collect();
     let message = format!("importing {} {}", s.benchmark, s.object);
-    let bar = image_progress(jobs.len(), progress, message);
+    let bar = stdx::progress::bar(jobs.len() as u64, "images", &message, progress);
     let stats = Mutex::new(SceneStats::default());
     jobs.par_iter().try_for_each(|&(vi, li)| -> Result<()> {
         let spec = &s.views[vi];
@@ -283,6 +283,6 @@ fn assemble(
         checksum: String::new(),
     };
     let json = manifest.to_json();
-    dataset_merl::atomic::write_atomic(&tmp.join(MANIFEST_FILE), json.as_bytes())?;
+    stdx::fs::write_atomic(&tmp.join(MANIFEST_FILE), json.as_bytes())?;
     Ok(Written { manifest, geometry, views: reports })
 }

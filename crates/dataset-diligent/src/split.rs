@@ -27,16 +27,7 @@ pub fn split_lights(
         ));
     }
     let mut order: Vec<usize> = (0..n).collect();
-    let mut state = seed ^ 0xD1_11_6E_47_5E_ED_00_01;
-    for i in (1..n).rev() {
-        // SplitMix64 step.
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        order.swap(i, (z % (i as u64 + 1)) as usize);
-    }
+    stdx::rng::SplitMix64::new(seed ^ 0xD1_11_6E_47_5E_ED_00_01).shuffle(&mut order);
     let mut tr = order[..train].to_vec();
     let mut te = order[train..train + test].to_vec();
     tr.sort_unstable();

@@ -78,3 +78,9 @@ impl Error {
         Self::Io { path: path.into(), source }
     }
 }
+
+impl From<stdx::fs::Error> for Error {
+    fn from(e: stdx::fs::Error) -> Self {
+        Self::Io { path: e.path, source: e.source }
+    }
+}

@@ -21,7 +21,6 @@
 //! # Ok::<(), dataset_merl::Error>(())
 //! ```
 
-pub mod atomic;
 pub mod catalogue;
 mod error;
 pub mod merl;

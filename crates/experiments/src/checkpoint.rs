@@ -7,7 +7,7 @@
 //! are removed only after the new one is complete, so a crash or a non-finite loss always
 //! leaves the last good one.
 
-use crate::run_dir::{CHECKPOINTS_DIR, CurveRow};
+use crate::run_dir::{CurveRow, RunDir};
 use crate::{Error, Result};
 use brdf_neural::BrdfModel;
 use burn::module::Module;
@@ -39,34 +39,25 @@ pub struct CheckpointState {
     pub stopped: Option<crate::plateau::StopReason>,
 }
 
-/// Folder of the checkpoint after `step` steps.
-pub fn checkpoint_dir(run: &Path, step: u64) -> PathBuf {
-    run.join(CHECKPOINTS_DIR).join(format!("step-{step:09}"))
-}
-
 /// Writes a checkpoint atomically and removes the older ones; returns its folder.
 pub fn save(
-    run: &Path,
+    run: &RunDir,
     model: &BrdfModel,
     optim: &ModuleOptimizer,
     state: &CheckpointState,
 ) -> Result<PathBuf> {
-    let root = run.join(CHECKPOINTS_DIR);
-    let dir = checkpoint_dir(run, state.step);
-    let tmp = root.join(format!(".tmp-step-{:09}-{}", state.step, std::process::id()));
-    let _ = std::fs::remove_dir_all(&tmp);
-    std::fs::create_dir_all(&tmp).map_err(|e| Error::io(&tmp, e))?;
-    model
-        .clone()
-        .save_file(tmp.join(MODEL))
-        .map_err(|e| Error::format(tmp.join(MODEL), format!("cannot write weights: {e:?}")))?;
-    optim
-        .save(tmp.join(OPTIM))
-        .map_err(|e| Error::format(tmp.join(OPTIM), format!("cannot write Adam state: {e:?}")))?;
-    let json = serde_json::to_string(state).map_err(|e| Error::format(&tmp, e.to_string()))?;
-    std::fs::write(tmp.join(STATE), json).map_err(|e| Error::io(tmp.join(STATE), e))?;
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::rename(&tmp, &dir).map_err(|e| Error::io(&dir, e))?;
+    let dir = run.checkpoint(state.step);
+    stdx::fs::write_dir_atomic(&dir, &[], |tmp| -> Result<()> {
+        model
+            .clone()
+            .save_file(tmp.join(MODEL))
+            .map_err(|e| Error::format(tmp.join(MODEL), format!("cannot write weights: {e:?}")))?;
+        optim.save(tmp.join(OPTIM)).map_err(|e| {
+            Error::format(tmp.join(OPTIM), format!("cannot write Adam state: {e:?}"))
+        })?;
+        let json = serde_json::to_string(state).map_err(|e| Error::format(tmp, e.to_string()))?;
+        std::fs::write(tmp.join(STATE), json).map_err(|e| Error::io(tmp.join(STATE), e))
+    })?;
     for old in list(run)? {
         if old.0 != state.step {
             let _ = std::fs::remove_dir_all(&old.1);
@@ -76,8 +67,8 @@ pub fn save(
 }
 
 /// Complete checkpoints of a run, oldest first.
-pub fn list(run: &Path) -> Result<Vec<(u64, PathBuf)>> {
-    let root = run.join(CHECKPOINTS_DIR);
+pub fn list(run: &RunDir) -> Result<Vec<(u64, PathBuf)>> {
+    let root = run.checkpoints();
     let entries = match std::fs::read_dir(&root) {
         Ok(e) => e,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
@@ -98,7 +89,7 @@ pub fn list(run: &Path) -> Result<Vec<(u64, PathBuf)>> {
 }
 
 /// The latest checkpoint, if any.
-pub fn latest(run: &Path) -> Result<Option<PathBuf>> {
+pub fn latest(run: &RunDir) -> Result<Option<PathBuf>> {
     Ok(list(run)?.pop().map(|(_, p)| p))
 }
 

@@ -71,7 +71,8 @@ pub struct FeatureConfig {
     pub spatial: SpatialKind,
     /// LBO index selection.
     pub lbo: LboSelection,
-    /// Eigenpair cache directory (default: `cache/` beside the run directory).
+    /// Cache directory (default: the sweep's `cache/` for a run of a sweep, else `cache/` beside
+    /// the run directory; `experiments::run_dir`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cache_dir: Option<PathBuf>,
 }

@@ -267,7 +267,7 @@ pub fn lbo_table(
     let encoding = lbo_encoding(scene, features, cache_dir)?;
     let table = encoding.as_slice().to_vec();
     let bytes: Vec<u8> = table.iter().flat_map(|v| v.to_le_bytes()).collect();
-    crate::run_dir::write_atomic(&path, &bytes)?;
+    stdx::fs::write_atomic(&path, &bytes)?;
     Ok((table, encoding.dim()))
 }
 

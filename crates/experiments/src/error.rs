@@ -92,3 +92,9 @@ impl Error {
 
 /// Result with [`Error`].
 pub type Result<T> = std::result::Result<T, Error>;
+
+impl From<stdx::fs::Error> for Error {
+    fn from(e: stdx::fs::Error) -> Self {
+        Self::Io { path: e.path, source: e.source }
+    }
+}

@@ -18,7 +18,6 @@ use angles::Rusinkiewicz;
 use dataset_merl::merl::format::TABLE_LEN;
 use dataset_merl::merl::lookup::bin_lower_edges;
 use dataset_merl::{MerlBrdf, SceneDataset};
-use indicatif::{ProgressBar, ProgressStyle};
 use metrics::BatchBrdf;
 use std::path::Path;
 
@@ -99,11 +98,7 @@ pub fn tabulate_merl(
     }
     let below_horizon = TABLE_LEN - idx.len();
     let batch = brdf.preferred_batch().max(1);
-    let bar = if progress { ProgressBar::new(idx.len() as u64) } else { ProgressBar::hidden() };
-    bar.set_style(
-        ProgressStyle::with_template("export {bar:40} {pos}/{len} bins, eta {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let bar = stdx::progress::bar(idx.len() as u64, "bins", "export", progress);
     let points = vec![point; batch];
     let mut out = vec![[0.0f32; 3]; batch];
     for start in (0..idx.len()).step_by(batch) {

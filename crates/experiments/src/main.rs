@@ -7,7 +7,7 @@ use clap::{Parser, Subcommand};
 use experiments::config::RunConfig;
 use experiments::eval::EnergyEstimator;
 use experiments::export::SurfacePoint;
-use experiments::run_dir::CONFIG_FILE;
+use experiments::run_dir::RunDir;
 use experiments::{FitOptions, FitOutcome};
 use std::path::PathBuf;
 
@@ -33,7 +33,8 @@ enum Command {
         /// Run directory.
         #[arg(long)]
         out: PathBuf,
-        /// Eigenpair cache directory (default: `<out>/../cache`).
+        /// Cache directory (default: `features.cache_dir`, else the sweep's `cache/` for a sweep
+        /// run, else `<out>/../cache`).
         #[arg(long)]
         cache: Option<PathBuf>,
         /// No progress bar.
@@ -48,7 +49,8 @@ enum Command {
         /// Scene directory (default: the one in the run's config).
         #[arg(long)]
         scene: Option<PathBuf>,
-        /// Eigenpair cache directory (default: `<run>/../cache`).
+        /// Cache directory (default: `features.cache_dir`, else the sweep's `cache/` for a sweep
+        /// run, else `<run>/../cache`).
         #[arg(long)]
         cache: Option<PathBuf>,
         /// No progress bar.
@@ -66,7 +68,8 @@ enum Command {
         /// (x, l) pairs (default: the run's `[eval]` setting).
         #[arg(long)]
         pairs: Option<usize>,
-        /// Eigenpair cache directory (default: `<run>/../cache`).
+        /// Cache directory (default: `features.cache_dir`, else the sweep's `cache/` for a sweep
+        /// run, else `<run>/../cache`).
         #[arg(long)]
         cache: Option<PathBuf>,
         /// No progress bar.
@@ -88,7 +91,8 @@ enum Command {
         /// Scene directory (default: the one in the run's config).
         #[arg(long)]
         scene: Option<PathBuf>,
-        /// Eigenpair cache directory (default: `<run>/../cache`).
+        /// Cache directory (default: `features.cache_dir`, else the sweep's `cache/` for a sweep
+        /// run, else `<run>/../cache`).
         #[arg(long)]
         cache: Option<PathBuf>,
         /// No progress bar.
@@ -100,7 +104,7 @@ enum Command {
 fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Fit { config, scene, out, cache, quiet } => {
-            let stored = out.join(CONFIG_FILE);
+            let stored = RunDir::new(&out).config();
             let path = match config {
                 Some(p) => p,
                 None if stored.is_file() => stored,

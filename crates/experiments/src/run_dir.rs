@@ -1,5 +1,6 @@
-//! The run directory and its files, all written atomically (temporary file in the same
-//! directory, then rename).
+//! Where runs live on disk: a run directory ([`RunDir`]) and the directory of a whole sweep
+//! ([`SweepLayout`]), each with named paths, so no other module spells a file name. Every file
+//! is written atomically (`stdx::fs`: temporary file in the same directory, then rename).
 //!
 //! ```text
 //! <run>/config.toml        the resolved configuration
@@ -8,40 +9,165 @@
 //! <run>/snapshots/         weights at geometrically spaced steps (`train.snapshots`)
 //! <run>/weights.bpk        final model weights (burnpack)
 //! <run>/checkpoints/step-NNNNNNNNN/{model.bpk, optim.bpk, state.json}
-//! <run>/renders/           eval: per test image EXR + sRGB PNG
+//! <run>/renders/           eval: per test image EXR + sRGB PNG (+ diffuse/specular parts)
+//! <run>/flip/              eval: HDR-FLIP error map per test image
+//! <run>/albedo/            eval: albedo maps of the additive models
+//! <run>/run.json           sweep runs only: id, object, dataset, purposes, code version
+//! <run>/sweep.log          sweep runs in child processes: their output
+//!
+//! <out>/scenes/  <out>/runs/<run>/  <out>/cache/  <out>/tables/  <out>/figures/   (a sweep)
 //! ```
+//!
+//! The cache (eigenpairs, LBO tables, noise ceilings) of a run is, in this order: the one
+//! given on the command line, the config's `features.cache_dir`, the sweep's `<out>/cache/` for
+//! a run of a sweep (one holding `run.json`), else `cache/` beside the run directory.
 
+use crate::config::RunConfig;
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// The resolved configuration.
-pub const CONFIG_FILE: &str = "config.toml";
-/// Metrics of the run.
-pub const METRICS_FILE: &str = "metrics.json";
-/// Training curve.
-pub const CURVE_FILE: &str = "curve.csv";
-/// Final weights.
-pub const WEIGHTS_FILE: &str = "weights.bpk";
-/// Checkpoint folder.
-pub const CHECKPOINTS_DIR: &str = "checkpoints";
-/// Folder of the weight snapshots of the run-time curve.
-pub const SNAPSHOTS_DIR: &str = "snapshots";
+/// A run directory and the paths of its files.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RunDir(PathBuf);
 
-/// Writes `bytes` to `path` atomically (temporary file beside it, then rename).
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = path.parent().unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let tmp = temp_path(path);
-    std::fs::write(&tmp, bytes).map_err(|e| Error::io(&tmp, e))?;
-    std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
+impl RunDir {
+    /// The run directory at `path` (nothing is created).
+    pub fn new(path: impl Into<PathBuf>) -> Self {
+        Self(path.into())
+    }
+
+    /// The directory itself.
+    pub fn path(&self) -> &Path {
+        &self.0
+    }
+
+    /// `config.toml`: the resolved configuration.
+    pub fn config(&self) -> PathBuf {
+        self.0.join("config.toml")
+    }
+
+    /// `metrics.json`: training figures, then the test metrics.
+    pub fn metrics(&self) -> PathBuf {
+        self.0.join("metrics.json")
+    }
+
+    /// `curve.csv`: the training curve.
+    pub fn curve(&self) -> PathBuf {
+        self.0.join("curve.csv")
+    }
+
+    /// `weights.bpk`: the final weights.
+    pub fn weights(&self) -> PathBuf {
+        self.0.join("weights.bpk")
+    }
+
+    /// The snapshot of the weights after `step` steps.
+    pub fn snapshot(&self, step: u64) -> PathBuf {
+        self.0.join("snapshots").join(format!("step-{step:09}.bpk"))
+    }
+
+    /// The folder of the checkpoints.
+    pub fn checkpoints(&self) -> PathBuf {
+        self.0.join("checkpoints")
+    }
+
+    /// The folder of the checkpoint after `step` steps.
+    pub fn checkpoint(&self, step: u64) -> PathBuf {
+        self.checkpoints().join(format!("step-{step:09}"))
+    }
+
+    /// The rendered test images.
+    pub fn renders(&self) -> PathBuf {
+        self.0.join("renders")
+    }
+
+    /// The HDR-FLIP error maps.
+    pub fn flip(&self) -> PathBuf {
+        self.0.join("flip")
+    }
+
+    /// The albedo maps (additive models).
+    pub fn albedo(&self) -> PathBuf {
+        self.0.join("albedo")
+    }
+
+    /// `run.json`: what a sweep knows of the run.
+    pub fn info(&self) -> PathBuf {
+        self.0.join("run.json")
+    }
+
+    /// `sweep.log`: the output of the child process that ran it.
+    pub fn log(&self) -> PathBuf {
+        self.0.join("sweep.log")
+    }
+
+    /// Whether the run finished training (weights and metrics written).
+    pub fn is_trained(&self) -> bool {
+        self.weights().is_file() && self.metrics().is_file()
+    }
+
+    /// Whether the run has been evaluated (test metrics written).
+    pub fn is_evaluated(&self) -> bool {
+        RunMetrics::read(&self.metrics()).is_ok_and(|m| m.test.is_some())
+    }
+
+    /// Reads the run's configuration.
+    pub fn read_config(&self) -> Result<RunConfig> {
+        RunConfig::read(&self.config())
+    }
+
+    /// The cache of the run (see the module documentation for the order).
+    pub fn cache(&self, config: &RunConfig, option: Option<&Path>) -> PathBuf {
+        let beside = || self.0.parent().unwrap_or(Path::new(".")).to_path_buf();
+        option.map(Path::to_path_buf).or_else(|| config.features.cache_dir.clone()).unwrap_or_else(
+            || match self.0.parent().and_then(Path::parent) {
+                Some(out) if self.info().is_file() => SweepLayout::new(out).cache(),
+                _ => beside().join("cache"),
+            },
+        )
+    }
 }
 
-/// A temporary sibling of `path` (same directory, so a rename is atomic).
-pub fn temp_path(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    // Keeps the extension: burn's writers may append theirs to a name without it.
-    path.with_file_name(format!(".tmp-{}-{name}", std::process::id()))
+/// The directory of a sweep and its parts.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SweepLayout(PathBuf);
+
+impl SweepLayout {
+    /// The sweep directory `out` (nothing is created).
+    pub fn new(out: impl Into<PathBuf>) -> Self {
+        Self(out.into())
+    }
+
+    /// The directory itself.
+    pub fn path(&self) -> &Path {
+        &self.0
+    }
+
+    /// The generated scenes.
+    pub fn scenes(&self) -> PathBuf {
+        self.0.join("scenes")
+    }
+
+    /// The run directories.
+    pub fn runs(&self) -> PathBuf {
+        self.0.join("runs")
+    }
+
+    /// The cache shared by the sweep's runs.
+    pub fn cache(&self) -> PathBuf {
+        self.0.join("cache")
+    }
+
+    /// The tables (Markdown, LaTeX).
+    pub fn tables(&self) -> PathBuf {
+        self.0.join("tables")
+    }
+
+    /// The figures (PNG).
+    pub fn figures(&self) -> PathBuf {
+        self.0.join("figures")
+    }
 }
 
 /// One row of the training curve.
@@ -69,7 +195,7 @@ pub fn write_curve(path: &Path, rows: &[CurveRow]) -> Result<()> {
         let val = r.val_loss.map_or(String::new(), |v| format!("{v:e}"));
         s.push_str(&format!("{},{:e},{val},{:e},{:.3}\n", r.step, r.loss, r.lr, r.seconds));
     }
-    write_atomic(path, s.as_bytes())
+    Ok(stdx::fs::write_atomic(path, s.as_bytes())?)
 }
 
 /// A kept snapshot of the weights (`snapshots/step-NNNNNNNNN.bpk`), for the run-time curve.
@@ -79,11 +205,6 @@ pub struct Snapshot {
     pub step: u64,
     /// Wall time of the run at that step, seconds.
     pub seconds: f64,
-}
-
-/// The file of the snapshot after `step` steps.
-pub fn snapshot_path(run: &Path, step: u64) -> PathBuf {
-    run.join(SNAPSHOTS_DIR).join(format!("step-{step:09}.bpk"))
 }
 
 /// `metrics.json`: training figures, and the test metrics once evaluated.
@@ -138,6 +259,6 @@ impl RunMetrics {
     pub fn write(&self, path: &Path) -> Result<()> {
         let text =
             serde_json::to_string_pretty(self).map_err(|e| Error::format(path, e.to_string()))?;
-        write_atomic(path, text.as_bytes())
+        Ok(stdx::fs::write_atomic(path, text.as_bytes())?)
     }
 }

@@ -17,7 +17,7 @@
 use crate::checkpoint::{self, CheckpointState};
 use crate::config::RunConfig;
 use crate::data::{TrainingData, spatial_features, split_validation, validation_pairs};
-use crate::run_dir::{CONFIG_FILE, METRICS_FILE, RunMetrics, WEIGHTS_FILE, write_atomic};
+use crate::run_dir::{RunDir, RunMetrics};
 use crate::train_config::OutputInit;
 use crate::trainer::{Loop, LoopEnd, gamma_mse, save_weights};
 use crate::{Error, Result};
@@ -27,7 +27,7 @@ use burn::optim::AdamConfig;
 use burn::tensor::Device;
 use dataset_merl::SceneDataset;
 use dataset_merl::scene::Split;
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use std::path::{Path, PathBuf};
 
 pub use crate::trainer::StepHook;
@@ -37,7 +37,7 @@ pub use crate::trainer::StepHook;
 pub struct FitOptions {
     /// Show a progress bar.
     pub progress: bool,
-    /// Eigenpair cache (overrides `features.cache_dir`; default `<run>/../cache`).
+    /// Cache directory (overrides `features.cache_dir`; default: `RunDir::cache`).
     pub cache_dir: Option<PathBuf>,
     /// Stop (with a checkpoint) after this many steps in total, as if interrupted.
     pub stop_after: Option<u64>,
@@ -101,18 +101,10 @@ pub fn training_data(config: &RunConfig, cache_dir: &Path) -> Result<RunData> {
     Ok(RunData { scene, train, val, val_floor })
 }
 
-/// The eigenpair cache of a run: the option, else the config, else `<run>/../cache`.
-pub fn cache_dir_for(config: &RunConfig, run: &Path, option: Option<&Path>) -> PathBuf {
-    option
-        .map(Path::to_path_buf)
-        .or_else(|| config.features.cache_dir.clone())
-        .unwrap_or_else(|| run.parent().unwrap_or(Path::new(".")).join("cache"))
-}
-
 /// Checks a run directory against `config`: a new run writes the config; an existing one must
 /// hold the same configuration. Returns the finished run's metrics, if finished.
-fn prepare_run_dir(config: &RunConfig, run: &Path) -> Result<Option<RunMetrics>> {
-    let path = run.join(CONFIG_FILE);
+fn prepare_run_dir(config: &RunConfig, run: &RunDir) -> Result<Option<RunMetrics>> {
+    let path = run.config();
     if path.is_file() {
         let existing = RunConfig::read(&path)?;
         if existing != *config {
@@ -126,11 +118,11 @@ fn prepare_run_dir(config: &RunConfig, run: &Path) -> Result<Option<RunMetrics>>
                 ),
             ));
         }
-        if run.join(WEIGHTS_FILE).is_file() && run.join(METRICS_FILE).is_file() {
-            return Ok(Some(RunMetrics::read(&run.join(METRICS_FILE))?));
+        if run.is_trained() {
+            return Ok(Some(RunMetrics::read(&run.metrics())?));
         }
     } else {
-        write_atomic(&path, config.to_toml()?.as_bytes())?;
+        stdx::fs::write_atomic(&path, config.to_toml()?.as_bytes())?;
     }
     Ok(None)
 }
@@ -163,10 +155,11 @@ fn differing_keys(a: &RunConfig, b: &RunConfig) -> Vec<String> {
 pub fn fit(config: &RunConfig, run: &Path, options: FitOptions) -> Result<FitOutcome> {
     config.validate()?;
     std::fs::create_dir_all(run).map_err(|e| Error::io(run, e))?;
-    if let Some(metrics) = prepare_run_dir(config, run)? {
+    let dir = RunDir::new(run);
+    if let Some(metrics) = prepare_run_dir(config, &dir)? {
         return Ok(FitOutcome::AlreadyFinished(metrics));
     }
-    let cache = cache_dir_for(config, run, options.cache_dir.as_deref());
+    let cache = dir.cache(config, options.cache_dir.as_deref());
     let RunData { train: data, val, val_floor, .. } = training_data(config, &cache)?;
     let t = &config.train;
 
@@ -178,13 +171,13 @@ pub fn fit(config: &RunConfig, run: &Path, options: FitOptions) -> Result<FitOut
     }
     let mut optim = AdamConfig::new().with_epsilon(t.adam_epsilon as f32).init();
     let mut state = CheckpointState::default();
-    let last_checkpoint = checkpoint::latest(run)?;
+    let last_checkpoint = checkpoint::latest(&dir)?;
     if let Some(dir) = &last_checkpoint {
         (model, optim, state) = checkpoint::load(dir, model, optim)?;
     }
     let resumed_from = state.step;
     let bar = progress_bar(options.progress, t.iterations, state.step);
-    let lp = Loop { config, run, data: &data, val: &val, device, bar };
+    let lp = Loop { config, run: &dir, data: &data, val: &val, device, bar };
     let end =
         lp.run(model, &mut optim, state, last_checkpoint, options.hook, options.stop_after)?;
     let (model, state) = match end {
@@ -196,25 +189,16 @@ pub fn fit(config: &RunConfig, run: &Path, options: FitOptions) -> Result<FitOut
     } else {
         format!("step budget reached ({} steps)", state.step)
     });
-    save_weights(&model, &run.join(WEIGHTS_FILE))?;
+    save_weights(&model, &dir.weights())?;
     let mut metrics = run_metrics(config, &state, &data, val.len());
     metrics.val_loss_floor = val_floor;
-    metrics.write(&run.join(METRICS_FILE))?;
+    metrics.write(&dir.metrics())?;
     Ok(FitOutcome::Finished { metrics, resumed_from })
 }
 
 /// The training progress bar over the step budget, at `position` (hidden unless `visible`).
 fn progress_bar(visible: bool, budget: u64, position: u64) -> ProgressBar {
-    if !visible {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(budget);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{bar:30} {pos}/{len} steps at most [{elapsed_precise}] {msg}",
-        )
-        .expect("static template"),
-    );
+    let bar = stdx::progress::bar(budget, "steps at most", "train", visible);
     bar.set_position(position);
     bar
 }
@@ -249,8 +233,8 @@ fn run_metrics(
 }
 
 /// Loads the final weights of a finished run.
-pub fn load_weights(config: &RunConfig, run: &Path, device: &Device) -> Result<BrdfModel> {
-    let path = run.join(WEIGHTS_FILE);
+pub fn load_weights(config: &RunConfig, run: &RunDir, device: &Device) -> Result<BrdfModel> {
+    let path = run.weights();
     if !path.is_file() {
         return Err(Error::format(&path, "no final weights: the run has not finished (run fit)"));
     }

@@ -12,7 +12,7 @@ use crate::data::TrainingData;
 use crate::diagnose::{all_finite, diagnose};
 use crate::loss::{LossWeights, loss, srgb_oetf};
 use crate::plateau::{Decision, StopReason};
-use crate::run_dir::{CURVE_FILE, CurveRow, Snapshot, snapshot_path, temp_path, write_curve};
+use crate::run_dir::{CurveRow, RunDir, Snapshot, write_curve};
 use crate::{Error, Result};
 use brdf_neural::{BrdfModel, Reciprocity, Samples};
 use burn::module::Module;
@@ -41,7 +41,7 @@ pub(crate) struct Loop<'a> {
     /// The run's configuration.
     pub config: &'a RunConfig,
     /// The run directory.
-    pub run: &'a Path,
+    pub run: &'a RunDir,
     /// Training records.
     pub data: &'a TrainingData,
     /// Validation records (empty without a validation split).
@@ -190,7 +190,7 @@ impl Loop<'_> {
 
     /// Writes the weights after `step` steps to the snapshot folder.
     fn save_snapshot(&self, model: &BrdfModel, step: u64) -> Result<()> {
-        let path = snapshot_path(self.run, step);
+        let path = self.run.snapshot(step);
         save_weights(model, &path)
     }
 
@@ -212,7 +212,7 @@ impl Loop<'_> {
             });
         }
         let dir = checkpoint::save(self.run, model, optim, state)?;
-        write_curve(&self.run.join(CURVE_FILE), &state.curve)?;
+        write_curve(&self.run.curve(), &state.curve)?;
         Ok(dir)
     }
 }
@@ -241,13 +241,10 @@ pub fn gamma_mse(records: &TrainingData, f: &[[f32; 3]]) -> f64 {
 
 /// Writes weights atomically (a temporary sibling with the same extension, then rename).
 pub fn save_weights(model: &BrdfModel, path: &Path) -> Result<()> {
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    }
-    let tmp = temp_path(path);
-    model
-        .clone()
-        .save_file(&tmp)
-        .map_err(|e| Error::format(&tmp, format!("cannot write weights: {e:?}")))?;
-    std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
+    stdx::fs::write_atomic_with(path, |tmp| {
+        model
+            .clone()
+            .save_file(tmp)
+            .map_err(|e| Error::format(tmp, format!("cannot write weights: {e:?}")))
+    })
 }

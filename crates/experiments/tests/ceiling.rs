@@ -9,9 +9,7 @@ use experiments::data::TrainingData;
 use experiments::eval::Prediction;
 use experiments::eval::images::{RenderOptions, render_and_score};
 
-#[path = "../../../test-support/temp_dir.rs"]
-mod temp_dir;
-use temp_dir::TempDir;
+use test_support::TempDir;
 
 fn smoke_scene(dir: &std::path::Path) -> SceneDataset {
     let config = SceneConfig {

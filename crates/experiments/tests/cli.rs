@@ -19,8 +19,8 @@ fn help_lists_the_commands() {
 
 #[test]
 fn a_bad_key_is_named() {
-    let dir = std::env::temp_dir().join(format!("experiments-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = test_support::TempDir::new("cli");
+    let dir = tmp.0.clone();
     let config = dir.join("bad.toml");
     std::fs::write(&config, "[train]\niteratons = 5\n").unwrap();
     let out = dir.join("run");
@@ -29,5 +29,4 @@ fn a_bad_key_is_named() {
     assert!(!ok && text.contains("iteratons") && text.contains("bad.toml"), "{text}");
     let (ok, text) = run(&["fit", "--out", out.to_str().unwrap()]);
     assert!(!ok && text.contains("--config"), "{text}");
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -7,15 +7,13 @@
 use burn::module::{ModuleMapper, Param};
 use burn::tensor::Tensor;
 use dataset_merl::scene::{MaterialSpec, SceneConfig, SceneSettings};
-use experiments::run_dir::{CURVE_FILE, WEIGHTS_FILE};
+use experiments::run_dir::RunDir;
 use experiments::{Error, FitOptions, FitOutcome, RunConfig, fit};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-#[path = "../../../test-support/temp_dir.rs"]
-mod temp_dir;
-use temp_dir::TempDir;
+use test_support::TempDir;
 
 /// OBJ of a UV sphere (radius 0.5, centre (0, 0, 0.7)) above the square z = 0.
 fn sphere_over_plane(dir: &Path) -> PathBuf {
@@ -92,7 +90,7 @@ fn config(kind: &str, iterations: u64, extra: &str) -> RunConfig {
 }
 
 fn losses(run: &Path) -> Vec<String> {
-    let text = std::fs::read_to_string(run.join(CURVE_FILE)).unwrap();
+    let text = std::fs::read_to_string(RunDir::new(run).curve()).unwrap();
     text.lines().skip(1).map(|l| l.split(',').take(2).collect::<Vec<_>>().join(",")).collect()
 }
 
@@ -122,7 +120,7 @@ fn models_fit_the_scene_and_eval_scores_them() {
         let (best, floor) = (metrics.best_val_loss.unwrap(), metrics.val_loss_floor.unwrap());
         assert!(best < 0.01 * f64::from(zero), "{kind}: validation {best}, zero {zero}");
         assert!(floor > 0.0 && floor < 1e-4 && floor < best, "{kind}: floor {floor}, {best}");
-        assert!(run.join(WEIGHTS_FILE).is_file());
+        assert!(RunDir::new(&run).weights().is_file());
         // A finished run is reported and skipped.
         let again = fit(&config(kind, 300, eval), &run, FitOptions::default()).unwrap();
         assert!(matches!(again, FitOutcome::AlreadyFinished(_)), "{again:?}");
@@ -194,7 +192,7 @@ fn runs_are_deterministic_and_resume_is_exact() {
     let out = fit(&c, &r, FitOptions::default()).unwrap();
     assert!(matches!(out, FitOutcome::Finished { resumed_from: 30, .. }), "{out:?}");
     assert_eq!(losses(&a), losses(&r));
-    let curve = |run: &Path| std::fs::read_to_string(run.join(CURVE_FILE)).unwrap();
+    let curve = |run: &Path| std::fs::read_to_string(RunDir::new(run).curve()).unwrap();
     let strip_time = |text: String| -> Vec<String> {
         text.lines().map(|l| l.rsplit_once(',').unwrap().0.to_string()).collect()
     };
@@ -265,7 +263,7 @@ fn a_non_finite_loss_stops_the_run_and_keeps_the_last_checkpoint() {
     );
     assert!(msg.contains("step-000000020"), "{msg}");
     assert!(run.join("checkpoints/step-000000020/model.bpk").is_file());
-    assert!(!run.join(WEIGHTS_FILE).exists());
+    assert!(!RunDir::new(&run).weights().exists());
 }
 
 #[test]

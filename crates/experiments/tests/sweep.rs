@@ -7,8 +7,7 @@
 use experiments::sweep::{self, Execution, SweepProfile};
 use std::path::PathBuf;
 
-#[path = "../../../test-support/shared_data.rs"]
-mod support;
+use test_support as support;
 
 fn shared_data() -> Option<PathBuf> {
     support::shared_data_root("")
@@ -52,8 +51,8 @@ runtime_curve = true
 #[test]
 fn a_miniature_sweep_produces_every_table_and_resumes() {
     let Some(data) = shared_data() else { return };
-    let out = std::env::temp_dir().join(format!("experiments-sweep-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out);
+    let tmp = test_support::TempDir::new("sweep");
+    let out = tmp.0.clone();
     let profile = SweepProfile::parse(PROFILE, "mini.toml").unwrap();
     let s = sweep::sweep(&profile, &out, &data, &Execution::InProcess).unwrap();
     assert!(s.failed.is_empty(), "{:?}", s.failed);
@@ -106,15 +105,14 @@ fn a_miniature_sweep_produces_every_table_and_resumes() {
     let text = std::fs::read_to_string(&jobs).unwrap();
     assert_eq!(text.lines().count(), 5);
     assert!(text.lines().all(|l| l.starts_with("run-one /")), "{text}");
-    let _ = std::fs::remove_dir_all(&out);
 }
 
 /// The built-in smoke profile (the shipped Spot mesh, no shared data needed): all 9 models and
 /// every ablation on 2 scenes, every table and figure written, nothing failed.
 #[test]
 fn the_smoke_profile_runs_end_to_end() {
-    let out = std::env::temp_dir().join(format!("experiments-smoke-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out);
+    let tmp = test_support::TempDir::new("smoke");
+    let out = tmp.0.clone();
     let profile = SweepProfile::load("smoke").unwrap();
     let s =
         sweep::sweep(&profile, &out, std::path::Path::new("data"), &Execution::InProcess).unwrap();
@@ -142,5 +140,4 @@ fn the_smoke_profile_runs_end_to_end() {
         let mapping = line.trim_end_matches('|').rsplit('|').next().unwrap().trim();
         assert_eq!(mapping.trim_matches('*'), "0.0000", "{line}");
     }
-    let _ = std::fs::remove_dir_all(&out);
 }

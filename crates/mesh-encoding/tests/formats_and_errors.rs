@@ -136,7 +136,8 @@ fn canonical(m: &TriMesh) -> Vec<[[u32; 3]; 3]> {
 
 #[test]
 fn every_format_gives_the_same_tetrahedron() {
-    let dir = common::temp_dir("formats");
+    let tmp = common::TempDir::new("formats");
+    let dir = tmp.0.clone();
     let (bin, json_ext) = gltf_parts(Some("tetra.bin"));
     write(&dir, "tetra.bin", &bin);
     let data_uri = format!(
@@ -166,12 +167,12 @@ fn every_format_gives_the_same_tetrahedron() {
         assert!(loaded.report.topology.is_closed_manifold());
         assert_eq!(loaded.report.topology.components, 1);
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn ply_quads_are_triangulated_and_binary_matches_ascii() {
-    let dir = common::temp_dir("ply-quads");
+    let tmp = common::TempDir::new("ply-quads");
+    let dir = tmp.0.clone();
     let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0], [9.0, 9.0, 9.0]];
     let f = vec![vec![0, 1, 2, 3]];
     let a = load_mesh(write(&dir, "q.ply", &ply_ascii(&p, &f)), &LoadOptions::default()).unwrap();
@@ -180,7 +181,6 @@ fn ply_quads_are_triangulated_and_binary_matches_ascii() {
     assert_eq!(a.mesh.triangles, vec![[0, 1, 2], [0, 2, 3]]);
     assert_eq!((a.report.polygon_faces, a.report.cleanup.unreferenced_vertices), (1, 1));
     assert_eq!(a.report.topology.boundary_edges, 4);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Loads `name` with `bytes` and returns the error message, checking it names the file.
@@ -197,7 +197,8 @@ fn error_of(dir: &Path, name: &str, bytes: &[u8]) -> (Error, String) {
 
 #[test]
 fn bad_input_gives_clear_errors() {
-    let dir = common::temp_dir("bad");
+    let tmp = common::TempDir::new("bad");
+    let dir = tmp.0.clone();
     let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
     let (e, m) =
         error_of(&dir, "nan.obj", format!("v nan 0 0\n{tri}f 2 3 4\nf 1 2 3\n").as_bytes());
@@ -246,5 +247,4 @@ fn bad_input_gives_clear_errors() {
     let missing = dir.join("does-not-exist.obj");
     let e = load_mesh(&missing, &LoadOptions::default()).unwrap_err();
     assert!(matches!(e, Error::Io { .. }) && e.to_string().contains("does-not-exist.obj"));
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -190,7 +190,8 @@ fn open_mesh_with_degenerate_triangles_gives_finite_neumann_spectrum() {
 #[test]
 fn cache_computes_loads_and_detects_corruption() {
     let (v, f) = icosphere(3);
-    let dir = common::temp_dir("lbo-cache");
+    let tmp = common::TempDir::new("lbo-cache");
+    let dir = tmp.0.clone();
     let s = small_settings();
     let (a, o) = cached_eigenpairs(&v, &f, 10, &s, &dir).unwrap();
     assert_eq!(o, CacheOutcome::Computed);
@@ -211,7 +212,6 @@ fn cache_computes_loads_and_detects_corruption() {
     assert!(matches!(&o, CacheOutcome::Recomputed(r) if r.contains("truncated")), "{o:?}");
     let (_, o) = cached_eigenpairs(&v, &f, 10, &s, &dir).unwrap();
     assert_eq!(o, CacheOutcome::Loaded);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

@@ -35,7 +35,6 @@ pub mod mixture;
 
 use crate::batch::BatchBrdf;
 use crate::error::{Error, Result};
-use indicatif::{ProgressBar, ProgressStyle};
 use mixture::{COMPONENTS, Mixture};
 use rand::{Rng, SeedableRng, rngs::StdRng};
 use rayon::prelude::*;
@@ -365,12 +364,7 @@ pub fn energy_conservation(
     };
     let group = (batch / per_pair).clamp(1, 256);
     let indexed: Vec<(usize, EnergyPair)> = pairs.iter().copied().enumerate().collect();
-    let bar =
-        if cfg.progress { ProgressBar::new(pairs.len() as u64) } else { ProgressBar::hidden() };
-    bar.set_style(
-        ProgressStyle::with_template("energy {bar:40} {pos}/{len} pairs, eta {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let bar = stdx::progress::bar(pairs.len() as u64, "pairs", "energy", cfg.progress);
     let start = Instant::now();
     let run = |g: &[(usize, EnergyPair)]| -> Vec<PairEnergy> {
         let out = match cfg.estimator {

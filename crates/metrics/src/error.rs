@@ -114,3 +114,9 @@ pub enum Error {
 
 /// `Result` with this crate's [`Error`].
 pub type Result<T> = std::result::Result<T, Error>;
+
+impl From<stdx::fs::Error> for Error {
+    fn from(e: stdx::fs::Error) -> Self {
+        Self::Io { path: e.path, source: e.source }
+    }
+}

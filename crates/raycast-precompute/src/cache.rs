@@ -14,13 +14,12 @@
 //! temporary file in the same directory, then a rename.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use mesh_encoding::{NormalWeighting, TriMesh};
 use xxhash_rust::xxh3::{Xxh3, xxh3_64};
 
 use crate::binio::{ReadResult, Reader, Writer};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::precompute::{
     PrecomputeSettings, ScenePrecompute, ShadowBias, TraceStats, View, ViewPrecompute,
     precompute_with, validate_views,
@@ -122,7 +121,7 @@ pub fn precompute_cached(
         Err(e) => CacheOutcome::Rebuilt { reason: format!("unreadable: {e}") },
     };
     let scene = precompute_with(&Tracer::new(mesh), views, &lights, settings, Traversal::default());
-    write_atomic(&path, &encode(&scene, key))?;
+    stdx::fs::write_atomic(&path, &encode(&scene, key))?;
     Ok((scene, outcome))
 }
 
@@ -219,19 +218,4 @@ pub(crate) fn decode(bytes: &[u8], key: u128) -> ReadResult<ScenePrecompute> {
         return Err("trailing bytes in the payload".into());
     }
     Ok(ScenePrecompute { views, shadow_bias, stats })
-}
-
-/// Writes `bytes` to `path` through a temporary file in the same directory and a rename.
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let dir = path.parent().unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).map_err(|source| Error::Io { path: dir.into(), source })?;
-    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-    let tmp = path.with_extension(format!("tmp-{}-{n}", std::process::id()));
-    let io = |source, p: &Path| Error::Io { path: p.into(), source };
-    std::fs::write(&tmp, bytes).map_err(|e| io(e, &tmp))?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        io(e, path)
-    })
 }

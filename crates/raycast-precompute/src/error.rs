@@ -31,3 +31,9 @@ pub enum Error {
         source: std::io::Error,
     },
 }
+
+impl From<stdx::fs::Error> for Error {
+    fn from(e: stdx::fs::Error) -> Self {
+        Self::Io { path: e.path, source: e.source }
+    }
+}

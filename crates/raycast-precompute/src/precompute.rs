@@ -11,7 +11,6 @@
 //! The result is stored struct-of-arrays per view (see [`ViewPrecompute`]).
 
 use glam::Vec3;
-use indicatif::{ProgressBar, ProgressStyle};
 use mesh_encoding::{NormalWeighting, TriMesh, interpolate_normal};
 use rayon::prelude::*;
 
@@ -208,10 +207,7 @@ pub(crate) fn precompute_with(
     let mesh = tracer.mesh();
     let vertex_normals = mesh.vertex_normals(settings.normal_weighting);
     let bias = bias_length(mesh, settings.shadow_bias);
-    let bar = ProgressBar::new(views.len() as u64).with_style(
-        ProgressStyle::with_template("ray casting {bar:30} {pos}/{len} views, {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let bar = stdx::progress::bar(views.len() as u64, "views", "ray casting", true);
     let mut out = ScenePrecompute { shadow_bias: bias, ..Default::default() };
     for (view, lights) in views.iter().zip(lights) {
         let (vp, stats) = trace_view(tracer, &vertex_normals, view, lights, bias, traversal);

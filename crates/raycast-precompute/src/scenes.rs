@@ -19,15 +19,8 @@ pub fn orbit_views(
     fov_y_deg: f32,
     seed: u64,
 ) -> Vec<View> {
-    let mut state = seed;
-    let mut uniform = move || {
-        // SplitMix64.
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    };
+    let mut rng = stdx::rng::SplitMix64::new(seed);
+    let mut uniform = move || rng.next_f32();
     let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
     (0..views)
         .map(|i| {

@@ -43,7 +43,7 @@ fn compare(tracer: &Tracer, reference: &BruteForce, origin: Vec3, dir: Vec3, tal
 #[test]
 fn bvh_agrees_with_brute_force_on_small_meshes() {
     let mut tally = Tally::default();
-    let mut rng = Rng(7);
+    let mut rng = Rng::new(7);
     for (name, res) in [("suzanne.obj", 96), ("woody.obj", 64), ("cow.obj", 48), ("spot.obj", 48)] {
         let Some(mesh) = common::shared_mesh(name) else { return };
         let tracer = Tracer::new(&mesh);
@@ -64,7 +64,7 @@ fn bvh_agrees_with_brute_force_on_small_meshes() {
         }
         // Shadow rays: from points just off the surface, in random directions.
         for _ in 0..1000 {
-            let t = (rng.next_u64() % mesh.triangle_count() as u64) as usize;
+            let t = (rng.0.next_u64() % mesh.triangle_count() as u64) as usize;
             let [v0, v1, v2] = mesh.corners(t);
             let n = (v1 - v0).cross(v2 - v0).normalize();
             let origin = (v0 + v1 + v2) / 3.0 + 1e-4 * n;

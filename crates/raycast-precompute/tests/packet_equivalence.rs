@@ -43,7 +43,7 @@ fn packets_match_one_by_one_on_real_meshes() {
 fn single_packets_match_per_ray_queries() {
     let Some(mesh) = common::shared_mesh("suzanne.obj") else { return };
     let tracer = Tracer::new(&mesh);
-    let mut rng = Rng(11);
+    let mut rng = Rng::new(11);
     let mut dirs: Vec<Vec3> = (0..40).map(|_| rng.direction()).collect();
     dirs.extend([Vec3::Z, -Vec3::Z, Vec3::X, -Vec3::Y, Vec3::new(-0.0, 0.6, -0.8)]);
     let (mut occluded, mut total) = (0usize, 0usize);
@@ -55,7 +55,7 @@ fn single_packets_match_per_ray_queries() {
                     if rng.uniform() < 0.2 {
                         return 1.5 * rng.direction();
                     }
-                    let t = (rng.next_u64() % mesh.triangle_count() as u64) as usize;
+                    let t = (rng.0.next_u64() % mesh.triangle_count() as u64) as usize;
                     let [v0, v1, v2] = mesh.corners(t);
                     let (a, b) = (rng.uniform(), rng.uniform());
                     let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
@@ -84,7 +84,7 @@ fn single_packets_match_per_ray_queries() {
 fn batched_closest_hits_match_closest_hit() {
     let Some(mesh) = common::shared_mesh("spot.obj") else { return };
     let tracer = Tracer::new(&mesh);
-    let mut rng = Rng(23);
+    let mut rng = Rng::new(23);
     // Camera rays of a tile-like bundle, plus random rays of every octant (some with -0.0).
     let mut origins = Vec::new();
     let mut dirs = Vec::new();

@@ -16,7 +16,7 @@ fn sphere_mesh() -> TriMesh {
 }
 
 fn views() -> Vec<View> {
-    let mut rng = common::Rng(3);
+    let mut rng = common::Rng::new(3);
     (0..3)
         .map(|_| {
             let eye = 3.0 * rng.direction();
@@ -82,7 +82,8 @@ fn layout_is_consistent_and_masks_restrict_tracing() {
 
 #[test]
 fn cache_miss_hit_corruption_and_keys() {
-    let dir = common::temp_dir("cache");
+    let tmp = common::TempDir::new("cache");
+    let dir = tmp.0.clone();
     let mesh = sphere_mesh();
     let views = views();
     let settings = PrecomputeSettings::default();
@@ -145,13 +146,13 @@ fn cache_miss_hit_corruption_and_keys() {
     assert_ne!(key, cache_key(&mesh, &views, &area));
     let abs = PrecomputeSettings { shadow_bias: ShadowBias::Absolute(1e-4), ..settings };
     assert_ne!(key, cache_key(&mesh, &views, &abs));
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn shared_mesh_from_two_file_names_shares_one_cache_entry() {
     let Some(data) = common::data_dir() else { return };
-    let dir = common::temp_dir("names");
+    let tmp = common::TempDir::new("names");
+    let dir = tmp.0.clone();
     let copy = dir.join("renamed-spot.obj");
     std::fs::copy(data.join("meshes/spot.obj"), &copy).unwrap();
     let options = mesh_encoding::LoadOptions::default();
@@ -163,5 +164,4 @@ fn shared_mesh_from_two_file_names_shares_one_cache_entry() {
     let s = PrecomputeSettings::default();
     assert_eq!(precompute_cached(&a, &views, &s, &cache).unwrap().1, CacheOutcome::Miss);
     assert_eq!(precompute_cached(&b, &views, &s, &cache).unwrap().1, CacheOutcome::Hit);
-    let _ = std::fs::remove_dir_all(&dir);
 }

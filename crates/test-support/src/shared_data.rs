@@ -1,7 +1,5 @@
 //! Where every crate's tests find the shared dataset: `$NEURAL_BRDF_DATA`, default
-//! `<workspace>/../shared/data`. One file, included by each crate's test helpers with
-//! `#[path = ".../test-support/shared_data.rs"] mod shared_data;` (test targets of different
-//! crates cannot share a module otherwise, and a crate for one function is not worth it).
+//! `<workspace>/../shared/data`.
 //!
 //! A missing dataset skips the test with a notice locally and fails it under `CI=true`.
 
@@ -12,8 +10,8 @@ use std::path::PathBuf;
 ///
 /// # Panics
 /// Under `CI=true` when `<root>/<probe>` is missing: CI must see the data.
-#[allow(dead_code)]
 pub fn shared_data_root(probe: &str) -> Option<PathBuf> {
+    // This crate lives at <workspace>/crates/test-support.
     let root = std::env::var_os("NEURAL_BRDF_DATA")
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));

@@ -1,34 +1,25 @@
-//! A fresh, empty directory under the system temp dir for one test, removed on drop; included
-//! by the test helpers of several crates with `#[path]` (see `shared_data.rs` beside it).
+//! A fresh, empty directory under the system temp dir for one test, removed on drop
+//! (`tempfile`'s, with the path in a public field for the tests' convenience).
 
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// A fresh empty directory `<temp>/<crate>-<tag>-<pid>-<n>`, removed on drop.
-pub struct TempDir(pub PathBuf);
+/// A fresh empty directory `<temp>/<tag>-XXXXXX`, removed on drop.
+pub struct TempDir(
+    pub PathBuf,
+    #[expect(dead_code, reason = "held for its Drop, which removes the directory")]
+    tempfile::TempDir,
+);
 
 impl TempDir {
-    /// Creates it (removing any leftover of the same name first).
+    /// Creates it.
     ///
     /// # Panics
     /// If the directory cannot be created.
-    #[allow(dead_code)]
     pub fn new(tag: &str) -> Self {
-        static N: AtomicUsize = AtomicUsize::new(0);
-        let p = std::env::temp_dir().join(format!(
-            "{}-{tag}-{}-{}",
-            env!("CARGO_PKG_NAME"),
-            std::process::id(),
-            N.fetch_add(1, Ordering::Relaxed)
-        ));
-        let _ = std::fs::remove_dir_all(&p);
-        std::fs::create_dir_all(&p).unwrap();
-        Self(p)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
+        let dir = tempfile::Builder::new()
+            .prefix(&format!("nbrdf-{tag}-"))
+            .tempdir()
+            .expect("create a temporary directory");
+        Self(dir.path().to_path_buf(), dir)
     }
 }

@@ -2,7 +2,7 @@
 //! restarts when the server ignores it, retries transfers cut midway (resuming each time), hashes
 //! while it writes, and shows a byte bar. Errors name the URL or the file and the fault.
 
-use super::progress::{bytes_bar, hash_into, hex};
+use super::progress::{hash_into, hex};
 use anyhow::{Context, Result, anyhow};
 use sha2::{Digest, Sha256};
 use std::fs::OpenOptions;
@@ -180,7 +180,7 @@ fn attempt_once(
     file.set_len(start).map_err(disk("truncating"))?;
     file.seek(SeekFrom::Start(start)).map_err(disk("seeking in"))?;
     let mut writer = std::io::BufWriter::with_capacity(1 << 20, file);
-    let pb = bytes_bar(label, total.or(expected_size));
+    let pb = stdx::progress::bytes(label, total.or(expected_size));
     pb.set_position(start);
     let mut reader = response.into_reader();
     let mut buf = vec![0u8; 1 << 16];

@@ -62,18 +62,8 @@ impl Lock {
              # manifest publishes none. Local knowledge: delete an entry to re-decide.\n{}",
             toml::to_string(self).context("serialising the lock file")?
         );
-        write_atomic(&self.path, text.as_bytes())
+        Ok(stdx::fs::write_atomic(&self.path, text.as_bytes())?)
     }
-}
-
-/// Writes `bytes` to `path` through a temporary file in the same directory and a rename.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, bytes).with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("renaming onto {}", path.display()))
 }
 
 #[cfg(test)]

@@ -3,7 +3,6 @@
 //! records the archive's sha256, so a later fetch skips it. Entry names that would leave the
 //! target directory (`..`, absolute paths) are refused.
 
-use super::progress::bytes_bar;
 use anyhow::{Context, Result, bail};
 use std::path::Path;
 
@@ -59,7 +58,7 @@ fn extract(archive: &Path, to: &Path) -> Result<usize> {
     let mut zip = zip::ZipArchive::new(std::io::BufReader::new(file)).with_context(bad)?;
     let total: u64 = (0..zip.len()).filter_map(|i| zip.by_index(i).ok().map(|f| f.size())).sum();
     let name = archive.file_name().map_or("archive".into(), |n| n.to_string_lossy());
-    let pb = bytes_bar(&format!("unpacking {name}"), Some(total));
+    let pb = stdx::progress::bytes(&format!("unpacking {name}"), Some(total));
     let mut files = 0;
     for i in 0..zip.len() {
         let mut entry = zip.by_index(i).with_context(bad)?;

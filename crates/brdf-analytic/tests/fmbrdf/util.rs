@@ -4,8 +4,8 @@ use super::reference::RefParams;
 use brdf_analytic::{FmbrdfParams, Real};
 use std::f64::consts::TAU;
 
-/// The crate's seeded SplitMix64 generator (`next_f64` is uniform in [0, 1)).
-pub use brdf_analytic::albedo::SplitMix64 as Rng;
+/// The workspace's seeded SplitMix64 generator (`next_f64` is uniform in [0, 1)).
+pub use stdx::rng::SplitMix64 as Rng;
 
 /// Maps `f` over `items` on all available cores (scoped threads), keeping the order.
 pub fn par_map<I: Sync, O: Send>(items: &[I], f: impl Fn(&I) -> O + Sync) -> Vec<O> {

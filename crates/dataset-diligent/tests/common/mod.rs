@@ -4,16 +4,13 @@
 
 use std::path::PathBuf;
 
-#[path = "../../../../test-support/temp_dir.rs"]
-mod temp_dir;
 #[allow(unused_imports)]
-pub use temp_dir::TempDir;
+pub use test_support::TempDir;
 
-#[path = "../../../../test-support/shared_data.rs"]
-mod support;
+use test_support as support;
 
 /// A folder of the shared data (`NEURAL_BRDF_DATA`, default `<workspace>/../shared/data`); see
-/// `test-support/shared_data.rs`.
+/// `test_support::shared_data_root`.
 pub fn shared(sub: &str) -> Option<PathBuf> {
     support::shared_data_root(sub).map(|root| root.join(sub))
 }

@@ -144,7 +144,7 @@ impl MerlBrdf {
 
     /// Writes the file atomically (temporary file in the same directory, then rename).
     pub fn write(&self, path: &Path) -> Result<()> {
-        crate::atomic::write_atomic(path, &self.to_bytes())
+        Ok(stdx::fs::write_atomic(path, &self.to_bytes())?)
     }
 
     /// Raw stored values, channel-planar.

@@ -50,30 +50,14 @@ pub struct GenerateReport {
     pub stats: SceneStats,
 }
 
-/// The progress bar of a scene's image writing (generation here, the DiLiGenT importers'
-/// scene writer): `count` images, hidden unless `visible`.
-pub fn image_progress(count: usize, visible: bool, message: String) -> indicatif::ProgressBar {
-    let bar = if visible {
-        indicatif::ProgressBar::new(count as u64)
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{msg} [{bar:30}] {pos}/{len} images, {elapsed} elapsed, eta {eta}",
-        )
-        .expect("valid template"),
-    );
-    bar.set_message(message);
-    bar
-}
-
 /// File stem of (view, light) data.
 pub fn sample_stem(view: usize, light: usize) -> String {
     format!("v{view:02}_l{light:02}")
 }
 
 /// Indices of the training views: a seeded shuffle of 0..views, first `train` of them, sorted.
+/// Its generator is a PCG-constant LCG, not the workspace's SplitMix64, and stays so: the split
+/// is part of every generated scene's bytes, so of every run id.
 fn train_views(views: usize, train: usize, seed: u64) -> Vec<bool> {
     let mut order: Vec<usize> = (0..views).collect();
     let mut state = seed ^ 0x5CE9_E5EE_D000_0001;
@@ -175,7 +159,7 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
 
     // Assemble under a temporary name beside the target.
     let subdirs = ["images", "clean", "brdf", "flags", "masks", "previews"];
-    let manifest = crate::atomic::write_dir_atomic(out, &subdirs, |tmp: &Path| -> Result<_> {
+    let manifest = stdx::fs::write_dir_atomic(out, &subdirs, |tmp: &Path| -> Result<_> {
         let settings = PrecomputeSettings {
             shadow_bias: ShadowBias::Relative(s.shadow_bias_relative),
             ..Default::default()
@@ -198,7 +182,8 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
 
         let jobs: Vec<(usize, usize)> =
             (0..s.views).flat_map(|v| (0..s.lights_per_view).map(move |l| (v, l))).collect();
-        let bar = image_progress(jobs.len(), progress, format!("rendering {}", out.display()));
+        let label = format!("rendering {}", out.display());
+        let bar = stdx::progress::bar(jobs.len() as u64, "images", &label, progress);
         let stats = Mutex::new(SceneStats::default());
         jobs.par_iter().try_for_each(|&(vi, li)| -> Result<()> {
             let vp = &geometry.views[vi];

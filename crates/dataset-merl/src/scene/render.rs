@@ -68,15 +68,15 @@ pub struct Sensor {
     pub seed: u64,
 }
 
-/// Normal deviates (Box-Muller) from the crate-wide SplitMix64, deterministic per seed.
+/// Normal deviates (Box-Muller) from the workspace's SplitMix64, deterministic per seed.
 struct Normal {
-    rng: brdf_analytic::albedo::SplitMix64,
+    rng: stdx::rng::SplitMix64,
     spare: Option<f64>,
 }
 
 impl Normal {
     fn new(seed: u64) -> Self {
-        Self { rng: brdf_analytic::albedo::SplitMix64::new(seed), spare: None }
+        Self { rng: stdx::rng::SplitMix64::new(seed), spare: None }
     }
     fn sample(&mut self) -> f64 {
         if let Some(s) = self.spare.take() {

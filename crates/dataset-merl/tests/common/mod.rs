@@ -3,16 +3,13 @@
 
 use std::path::PathBuf;
 
-#[path = "../../../../test-support/temp_dir.rs"]
-mod temp_dir;
 #[allow(unused_imports)]
-pub use temp_dir::TempDir;
+pub use test_support::TempDir;
 
-#[path = "../../../../test-support/shared_data.rs"]
-mod support;
+use test_support as support;
 
 /// The shared data folder (`NEURAL_BRDF_DATA`, default `<workspace>/../shared/data`); see
-/// `test-support/shared_data.rs`.
+/// `test_support::shared_data_root`.
 pub fn shared_data() -> Option<PathBuf> {
     support::shared_data_root("")
 }

@@ -3,8 +3,8 @@
 
 use crate::config::RunConfig;
 use crate::data::{TrainingData, spatial_features};
-use crate::run_dir::CONFIG_FILE;
-use crate::train::{cache_dir_for, load_weights};
+use crate::run_dir::RunDir;
+use crate::train::load_weights;
 use crate::{Error, Result};
 use brdf_neural::BrdfModel;
 use burn::tensor::Device;
@@ -29,7 +29,8 @@ pub struct FittedRun {
 impl FittedRun {
     /// Opens `run`; `scene` overrides the configured scene directory, `cache` the cache.
     pub fn open(run: &Path, scene: Option<&Path>, cache: Option<&Path>) -> Result<Self> {
-        let mut config = RunConfig::read(&run.join(CONFIG_FILE))?;
+        let run = RunDir::new(run);
+        let mut config = run.read_config()?;
         if let Some(s) = scene {
             config.scene = Some(s.to_path_buf());
         }
@@ -38,9 +39,9 @@ impl FittedRun {
             .clone()
             .ok_or_else(|| Error::config("scene", "no scene directory (pass --scene)"))?;
         let device = brdf_neural::device::cpu();
-        let model = load_weights(&config, run, &device)?;
+        let model = load_weights(&config, &run, &device)?;
         let dataset = SceneDataset::open(&scene_dir)?;
-        let cache = cache_dir_for(&config, run, cache);
+        let cache = run.cache(&config, cache);
         Ok(Self { config, device, model, dataset, cache })
     }
 

@@ -32,13 +32,12 @@
 
 use super::predict::Prediction;
 use crate::data::TrainingData;
-use crate::run_dir::write_atomic;
 use crate::{Error, Result};
 use dataset_merl::scene::Split;
 use dataset_merl::scene::images::{write_exr_rgb, write_png_srgb};
 use dataset_merl::scene::render::shade;
 use dataset_merl::{SampleSet, SceneDataset};
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use metrics::Image;
 use metrics::lpips::Lpips;
 use rayon::prelude::*;
@@ -105,7 +104,7 @@ pub fn write_png_rgb8(path: &Path, width: usize, height: usize, rgb: &[[u8; 3]])
     image::codecs::png::PngEncoder::new(&mut bytes)
         .write_image(&flat, width as u32, height as u32, image::ExtendedColorType::Rgb8)
         .map_err(|e| Error::format(path, format!("PNG encoding: {e}")))?;
-    write_atomic(path, &bytes)
+    Ok(stdx::fs::write_atomic(path, &bytes)?)
 }
 
 fn to_image(w: usize, h: usize, v: &[[f32; 3]]) -> Result<Image> {
@@ -343,12 +342,7 @@ impl<'a> TestImages<'a> {
 }
 
 fn progress_bar(len: usize, visible: bool) -> ProgressBar {
-    let bar = if visible { ProgressBar::new(len as u64) } else { ProgressBar::hidden() };
-    bar.set_style(
-        ProgressStyle::with_template("eval {bar:40} {pos}/{len} test images, eta {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    bar
+    stdx::progress::bar(len as u64, "test images", "eval", visible)
 }
 
 /// The image folders of a run.
@@ -364,11 +358,8 @@ impl OutputDirs {
         if !write {
             return Ok(None);
         }
-        let d = OutputDirs {
-            renders: run.join("renders"),
-            flips: run.join("flip"),
-            albedo: run.join("albedo"),
-        };
+        let run = crate::run_dir::RunDir::new(run);
+        let d = OutputDirs { renders: run.renders(), flips: run.flip(), albedo: run.albedo() };
         for dir in [&d.renders, &d.flips, &d.albedo] {
             std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
         }

@@ -28,7 +28,7 @@ pub use settings::{EnergyEstimator, EvalConfig, EvalSettings};
 
 use crate::Result;
 use crate::data::TrainingData;
-use crate::run_dir::{METRICS_FILE, RunMetrics, Snapshot, snapshot_path};
+use crate::run_dir::{RunDir, RunMetrics, Snapshot};
 use dataset_merl::SampleSet;
 use metrics::rmse::{CubeRootRmse, RmseConfig};
 use serde::{Deserialize, Serialize};
@@ -156,7 +156,7 @@ impl CeilingCache {
     fn write(&self, ceiling: &ImageMetrics) -> Result<()> {
         let text = serde_json::to_string_pretty(ceiling)
             .map_err(|e| crate::Error::format(&self.0, e.to_string()))?;
-        crate::run_dir::write_atomic(&self.0, text.as_bytes())
+        Ok(stdx::fs::write_atomic(&self.0, text.as_bytes())?)
     }
 }
 
@@ -169,7 +169,7 @@ fn snapshot_curve(
 ) -> Result<Vec<CurvePoint>> {
     let mut out = Vec::with_capacity(snapshots.len());
     for s in snapshots {
-        let model = fitted.load_weights_file(&snapshot_path(run, s.step))?;
+        let model = fitted.load_weights_file(&RunDir::new(run).snapshot(s.step))?;
         let pred = predict(&model, &fitted.config.model, data, &fitted.device, false)?;
         let psnr = images::mean_psnr(&fitted.dataset, samples, data, &pred.f)?;
         let (rmse_cbrt, _) = cube_root_rmse(samples, data, &pred.f)?;
@@ -218,7 +218,7 @@ pub fn eval(
     let brdf = ModelBrdf { model, config: &config.model, data: &data, device };
     let reciprocity_rmse = analyses::reciprocity(&brdf, &settings)?;
     let energy = analyses::energy(&brdf, &settings, config.seed, progress)?;
-    let path = run.join(METRICS_FILE);
+    let path = RunDir::new(run).metrics();
     let mut all = RunMetrics::read(&path)?;
     let curve = snapshot_curve(&fitted, run, &all.snapshots, (&samples, &data))?;
     let test = TestMetrics {

@@ -26,10 +26,14 @@ use crate::plateau::StopReason;
 use crate::report::{
     self, Dataset, MetricKind, ModelRender, QualitativeRow, RgbImage, RunOptions, RunRecord, Table,
 };
-use crate::run_dir::{CONFIG_FILE, METRICS_FILE, RunMetrics, write_atomic};
+use crate::run_dir::{RunDir, RunMetrics, SweepLayout};
 use crate::{Error, Result};
+use dataset_merl::scene::render::flag;
 use metrics::aggregate::Score;
 use std::path::{Path, PathBuf};
+
+/// The pixels the masked image metrics score: on the object (lit, shadowed or facing away).
+const FOREGROUND: u8 = flag::LIT | flag::SHADOWED | flag::BACK_FACING;
 
 /// One collected run.
 #[derive(Clone, Debug)]
@@ -65,7 +69,8 @@ pub fn find_runs(paths: &[PathBuf]) -> Vec<PathBuf> {
     let mut out = Vec::new();
     let mut stack: Vec<PathBuf> = paths.to_vec();
     while let Some(p) = stack.pop() {
-        if p.join(CONFIG_FILE).is_file() && p.join(METRICS_FILE).is_file() {
+        let run = RunDir::new(&p);
+        if run.config().is_file() && run.metrics().is_file() {
             out.push(p);
             continue;
         }
@@ -83,10 +88,11 @@ pub fn find_runs(paths: &[PathBuf]) -> Vec<PathBuf> {
 
 /// The record of an evaluated run (`None` when it has no test metrics yet).
 pub fn read_run(dir: &Path) -> Result<Option<CollectedRun>> {
-    let config = RunConfig::read(&dir.join(CONFIG_FILE))?;
-    let m = RunMetrics::read(&dir.join(METRICS_FILE))?;
+    let run = RunDir::new(dir);
+    let config = run.read_config()?;
+    let m = RunMetrics::read(&run.metrics())?;
     let Some(t) = m.test.as_ref() else { return Ok(None) };
-    let (object, dataset, purposes) = match plan::read_info(dir) {
+    let (object, dataset, purposes) = match plan::read_info(&run) {
         Ok(i) => (i.object, Dataset::from_label(&i.dataset), i.purposes),
         Err(_) => {
             let object = config
@@ -207,9 +213,9 @@ pub struct CollectSummary {
     pub files: Vec<PathBuf>,
 }
 
-fn write(out: &Path, rel: &str, bytes: &[u8], summary: &mut CollectSummary) -> Result<()> {
-    let path = out.join(rel);
-    write_atomic(&path, bytes)?;
+/// Writes one output of a sweep (a table or a figure) to `path`, atomically.
+fn write(path: PathBuf, bytes: &[u8], summary: &mut CollectSummary) -> Result<()> {
+    stdx::fs::write_atomic(&path, bytes)?;
     summary.files.push(path);
     Ok(())
 }
@@ -272,11 +278,15 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
             let plot = report::runtime_plot(&curves, &d, metric, reference, profile);
             if !plot.series.is_empty() {
                 let png = report::line_plot_png(&plot)?;
-                write(out, &format!("figures/runtime-{name}.png"), &png, &mut summary)?;
+                write(
+                    SweepLayout::new(out).figures().join(format!("runtime-{name}.png")),
+                    &png,
+                    &mut summary,
+                )?;
             }
         }
     }
-    write(out, "tables/all.md", all_md.as_bytes(), &mut summary)?;
+    write(SweepLayout::new(out).tables().join("all.md"), all_md.as_bytes(), &mut summary)?;
     Ok(summary)
 }
 
@@ -327,8 +337,9 @@ fn write_tables(
 ) -> Result<()> {
     for (name, t) in tables {
         let md = report::to_markdown(t);
-        write(out, &format!("tables/{name}.md"), md.as_bytes(), summary)?;
-        write(out, &format!("tables/{name}.tex"), report::to_latex(t).as_bytes(), summary)?;
+        let tables = SweepLayout::new(out).tables();
+        write(tables.join(format!("{name}.md")), md.as_bytes(), summary)?;
+        write(tables.join(format!("{name}.tex")), report::to_latex(t).as_bytes(), summary)?;
         all_md.push_str(&md);
         all_md.push('\n');
     }
@@ -384,15 +395,16 @@ fn figures(runs: &[CollectedRun], out: &Path, summary: &mut CollectSummary) -> R
             &scene.join(format!("flags/{}.png", dataset_merl::scene::generate::sample_stem(v, l))),
         );
         let mask: Option<Vec<bool>> =
-            flags.ok().map(|(_, _, f)| f.iter().map(|&b| b & 7 != 0).collect());
+            flags.ok().map(|(_, _, f)| f.iter().map(|&b| b & FOREGROUND != 0).collect());
         let mut renders = Vec::new();
         let mut split_rows = Vec::new();
         for r in &mine {
-            let Ok(img) = load_exr(&r.dir.join(format!("renders/{stem}.exr"))) else { continue };
+            let run = RunDir::new(&r.dir);
+            let Ok(img) = load_exr(&run.renders().join(format!("{stem}.exr"))) else { continue };
             let psnr = metrics::psnr_linear(&img, &gt, mask.as_deref())
                 .map(Score::Value)
                 .unwrap_or_else(|e| Score::Unavailable(e.to_string()));
-            let flip = load_png(&r.dir.join(format!("flip/{stem}.png"))).ok().map(|map| {
+            let flip = load_png(&run.flip().join(format!("{stem}.png"))).ok().map(|map| {
                 let mean = metrics::hdr_flip(&img, &gt, mask.as_deref())
                     .map(Score::Value)
                     .unwrap_or_else(|e| Score::Unavailable(e.to_string()));
@@ -408,11 +420,11 @@ fn figures(runs: &[CollectedRun], out: &Path, summary: &mut CollectSummary) -> R
             if r.record.model.is_additive() {
                 let mut cells = vec![("render".to_string(), RgbImage::from_linear(&img))];
                 for (label, file) in [
-                    ("diffuse", format!("renders/{stem}_diffuse.png")),
-                    ("specular", format!("renders/{stem}_specular.png")),
-                    ("albedo", format!("albedo/view{v:03}.png")),
+                    ("diffuse", run.renders().join(format!("{stem}_diffuse.png"))),
+                    ("specular", run.renders().join(format!("{stem}_specular.png"))),
+                    ("albedo", run.albedo().join(format!("view{v:03}.png"))),
                 ] {
-                    if let Ok(p) = load_png(&r.dir.join(file)) {
+                    if let Ok(p) = load_png(&file) {
                         cells.push((label.to_string(), p));
                     }
                 }
@@ -426,8 +438,7 @@ fn figures(runs: &[CollectedRun], out: &Path, summary: &mut CollectSummary) -> R
         };
         let grid = report::qualitative_grid(&format!("{object}: test view {v}, light {l}"), &[row]);
         write(
-            out,
-            &format!("figures/qualitative-{object}.png"),
+            SweepLayout::new(out).figures().join(format!("qualitative-{object}.png")),
             &report::image_grid_png(&grid)?,
             summary,
         )?;
@@ -439,8 +450,7 @@ fn figures(runs: &[CollectedRun], out: &Path, summary: &mut CollectSummary) -> R
                 split_rows,
             );
             write(
-                out,
-                &format!("figures/split-{object}.png"),
+                SweepLayout::new(out).figures().join(format!("split-{object}.png")),
                 &report::image_grid_png(&grid)?,
                 summary,
             )?;
@@ -451,7 +461,7 @@ fn figures(runs: &[CollectedRun], out: &Path, summary: &mut CollectSummary) -> R
 
 /// The stem (`view007_light003`) of the first EXR render of a run.
 fn first_render(run: &Path) -> Option<String> {
-    let mut names: Vec<String> = std::fs::read_dir(run.join("renders"))
+    let mut names: Vec<String> = std::fs::read_dir(RunDir::new(run).renders())
         .ok()?
         .flatten()
         .filter_map(|e| e.file_name().to_str().map(String::from))

@@ -10,11 +10,10 @@
 use super::plan::{self, Purpose, RunInfo, RunSpec, SceneSpec};
 use super::profile::{SweepProfile, resolve_mesh};
 use crate::config::SpatialKind;
-use crate::run_dir::{METRICS_FILE, RunMetrics};
+use crate::run_dir::{RunDir, SweepLayout};
 use crate::{Error, FitOptions, FitOutcome, Result, fit};
 use dataset_merl::scene::{MaterialSpec, SceneConfig, SceneSettings};
 use dataset_merl::{SceneDataset, generate_scene};
-use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
@@ -63,7 +62,7 @@ pub struct SweepSummary {
 
 /// Whether a run directory holds an evaluated run.
 pub fn is_done(run: &Path) -> bool {
-    RunMetrics::read(&run.join(METRICS_FILE)).is_ok_and(|m| m.test.is_some())
+    RunDir::new(run).is_evaluated()
 }
 
 /// Fits (resuming) and evaluates one prepared run directory.
@@ -71,16 +70,17 @@ pub fn run_one(run: &Path, progress: bool) -> Result<()> {
     if is_done(run) {
         return Ok(());
     }
-    let config = crate::RunConfig::read(&run.join(crate::run_dir::CONFIG_FILE))?;
-    let cache = run.parent().and_then(Path::parent).map(|o| o.join("cache"));
-    let options = FitOptions { progress, cache_dir: cache.clone(), ..Default::default() };
+    let dir = RunDir::new(run);
+    let config = dir.read_config()?;
+    let cache = dir.cache(&config, None);
+    let options = FitOptions { progress, cache_dir: Some(cache.clone()), ..Default::default() };
     match fit(&config, run, options)? {
         FitOutcome::Stopped(step) => {
             return Err(Error::format(run, format!("training stopped at step {step}")));
         }
         FitOutcome::Finished { .. } | FitOutcome::AlreadyFinished(_) => {}
     }
-    crate::eval::eval(run, None, cache.as_deref(), progress)?;
+    crate::eval::eval(run, None, Some(&cache), progress)?;
     Ok(())
 }
 
@@ -133,7 +133,7 @@ pub fn prepare_runs(
     for spec in specs {
         let id = plan::run_id(&spec.config, &checksums[spec.scene])?;
         let object = &scenes[spec.scene].name;
-        let dir = runs_dir.join(plan::run_dir_name(object, &spec.config, &id));
+        let dir = RunDir::new(runs_dir.join(plan::run_dir_name(object, &spec.config, &id)));
         let mut purposes: Vec<Purpose> =
             plan::read_info(&dir).map(|i| i.purposes).unwrap_or_default();
         for p in &spec.purposes {
@@ -153,12 +153,12 @@ pub fn prepare_runs(
             std::path::absolute(&scene_dirs[spec.scene])
                 .map_err(|e| Error::io(&scene_dirs[spec.scene], e))?,
         );
-        let config_path = dir.join(crate::run_dir::CONFIG_FILE);
+        let config_path = dir.config();
         if !config_path.is_file() {
-            crate::run_dir::write_atomic(&config_path, config.to_toml()?.as_bytes())?;
+            stdx::fs::write_atomic(&config_path, config.to_toml()?.as_bytes())?;
         }
         plan::write_info(&dir, &info)?;
-        dirs.push(dir);
+        dirs.push(dir.path().to_path_buf());
     }
     Ok(dirs)
 }
@@ -185,13 +185,7 @@ pub fn prepare_features(specs: &[RunSpec], scene_dirs: &[PathBuf], cache: &Path)
 pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) -> Result<()> {
     let todo: Vec<&PathBuf> = dirs.iter().filter(|d| !is_done(d)).collect();
     summary.skipped = dirs.len() - todo.len();
-    let bar = ProgressBar::new(todo.len() as u64);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "runs {bar:40} {pos}/{len} [{elapsed_precise}, eta {eta}] {msg}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let bar = stdx::progress::bar(todo.len() as u64, "runs", "sweep", true);
     match how {
         Execution::InProcess => {
             for d in &todo {
@@ -211,7 +205,7 @@ pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) ->
             loop {
                 while running.len() < (*jobs).max(1) {
                     let Some(d) = queue.next() else { break };
-                    let log = d.join("sweep.log");
+                    let log = RunDir::new(d.as_path()).log();
                     std::fs::create_dir_all(d).map_err(|e| Error::io(d, e))?;
                     let file = std::fs::File::create(&log).map_err(|e| Error::io(&log, e))?;
                     let err = file.try_clone().map_err(|e| Error::io(&log, e))?;
@@ -239,7 +233,7 @@ pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) ->
                         } else {
                             summary.failed.push((
                                 d.clone(),
-                                format!("{status}; see {}", d.join("sweep.log").display()),
+                                format!("{status}; see {}", RunDir::new(&d).log().display()),
                             ));
                         }
                         bar.inc(1);
@@ -259,7 +253,7 @@ pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) ->
                 text.push_str(&parts.join(" "));
                 text.push('\n');
             }
-            crate::run_dir::write_atomic(file, text.as_bytes())?;
+            stdx::fs::write_atomic(file, text.as_bytes())?;
             summary.emitted = todo.len();
         }
     }
@@ -289,7 +283,8 @@ pub fn sweep(
 ) -> Result<SweepSummary> {
     let start = Instant::now();
     let mut summary = SweepSummary::default();
-    let (scenes_dir, runs_dir, cache) = plan::layout(out);
+    let layout = SweepLayout::new(out);
+    let (scenes_dir, runs_dir, cache) = (layout.scenes(), layout.runs(), layout.cache());
     let scenes = plan::scenes(profile);
     let specs = plan::runs(profile)?;
     let scene_dirs = prepare_scenes(profile, &scenes, &scenes_dir, data_root, &mut summary)?;

@@ -10,10 +10,11 @@
 use super::profile::{Ablation, SweepProfile, mesh_name};
 use crate::config::RunConfig;
 use crate::report::RunOptions;
+use crate::run_dir::RunDir;
 use crate::{Error, Result};
 use brdf_neural::{AngleParametrization, ModelKind, Reciprocity};
 use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The version of the code that results depend on: bump it with any change that alters a
 /// result (training, models, data generation or metrics), so that content-addressed runs of
@@ -206,26 +207,18 @@ pub fn run_dir_name(object: &str, config: &RunConfig, id: &str) -> String {
 }
 
 /// Reads `run.json`.
-pub fn read_info(run: &Path) -> Result<RunInfo> {
-    let path = run.join(RUN_INFO_FILE);
+pub fn read_info(run: &RunDir) -> Result<RunInfo> {
+    let path = run.info();
     let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
     serde_json::from_str(&text).map_err(|e| Error::format(&path, e.to_string()))
 }
 
 /// Writes `run.json` atomically.
-pub fn write_info(run: &Path, info: &RunInfo) -> Result<()> {
-    let path = run.join(RUN_INFO_FILE);
+pub fn write_info(run: &RunDir, info: &RunInfo) -> Result<()> {
+    let path = run.info();
     let text =
         serde_json::to_string_pretty(info).map_err(|e| Error::format(&path, e.to_string()))?;
-    crate::run_dir::write_atomic(&path, text.as_bytes())
-}
-
-/// The file naming a sweep's run directory.
-pub const RUN_INFO_FILE: &str = "run.json";
-
-/// Where the sweep keeps scenes, runs, caches and results under `out`.
-pub fn layout(out: &Path) -> (PathBuf, PathBuf, PathBuf) {
-    (out.join("scenes"), out.join("runs"), out.join("cache"))
+    Ok(stdx::fs::write_atomic(&path, text.as_bytes())?)
 }
 
 #[cfg(test)]

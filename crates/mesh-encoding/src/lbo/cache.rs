@@ -10,7 +10,6 @@
 //!   never sees a half-written file. A file with a wrong magic, version, key, size or checksum
 //!   is reported as [`CacheOutcome::Recomputed`] and overwritten.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use faer::Mat;
@@ -105,7 +104,10 @@ pub fn cached_eigenpairs(
     };
     let matrices = LboMatrices::assemble(vertices, triangles)?;
     let (pairs, _report) = smallest_eigenpairs(&matrices, k, settings)?;
-    write_atomic(&path, &encode(&pairs, key))?;
+    stdx::fs::write_atomic(&path, &encode(&pairs, key)).map_err(|e| Error::LboCache {
+        path: e.path,
+        message: format!("cannot write: {}", e.source),
+    })?;
     Ok((pairs, outcome))
 }
 
@@ -162,25 +164,6 @@ fn decode(bytes: &[u8], key: u128, n: usize, k: usize) -> std::result::Result<Ei
     let base = HEADER_LEN + 8 * k;
     let vectors = Mat::<f64>::from_fn(n, k, |i, j| f64_at(base + 8 * (j * n + i)));
     Ok(Eigenpairs { values, vectors })
-}
-
-/// Writes `bytes` to a temporary file next to `path` and renames it into place.
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let fail = |message: String| Error::LboCache { path: path.to_owned(), message };
-    let dir = path.parent().unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).map_err(|e| fail(format!("cannot create the directory: {e}")))?;
-    let file_name = path.file_name().and_then(|s| s.to_str()).unwrap_or("lbo.bin");
-    let tmp = dir.join(format!(".{file_name}.tmp-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    result.map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        fail(format!("cannot write: {e}"))
-    })
 }
 
 #[cfg(test)]

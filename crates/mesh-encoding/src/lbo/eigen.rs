@@ -50,6 +50,7 @@ use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
 use super::assembly::LboMatrices;
 use super::lanczos::{Ritz, block_lanczos};
 use crate::error::{Error, Result};
+use stdx::rng::SplitMix64;
 
 /// Settings of [`smallest_eigenpairs`]. They are part of the eigenpair cache key.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -392,7 +393,7 @@ pub(crate) fn orthonormalize_block(
             r[(i, j)] = 0.0;
         }
         let n = w.nrows();
-        let mut x = Mat::<f64>::from_fn(n, 1, |_, _| rng.uniform());
+        let mut x = Mat::<f64>::from_fn(n, 1, |_, _| rng.next_signed_f64());
         for _ in 0..2 {
             if basis.ncols() > 0 {
                 let c = basis.transpose() * &x;
@@ -480,19 +481,4 @@ pub fn dense_eigenpairs(matrices: &LboMatrices, k: usize) -> Result<Eigenpairs> 
     let vectors = Mat::<f64>::from_fn(n, k, |i, j| d[i] * u[(i, j)]);
     let values = (0..k).map(|j| s[j]).collect();
     Ok(sort_pairs(values, vectors))
-}
-
-/// Small deterministic generator for the start block (SplitMix64).
-pub(crate) struct SplitMix64(pub(crate) u64);
-
-impl SplitMix64 {
-    /// Uniform in [-1, 1).
-    pub(crate) fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
 }

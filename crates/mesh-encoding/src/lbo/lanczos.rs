@@ -18,8 +18,9 @@ use std::time::Instant;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
 
-use super::eigen::{EigenSettings, SplitMix64, orthonormalize_block};
+use super::eigen::{EigenSettings, orthonormalize_block};
 use crate::error::{Error, Result};
+use stdx::rng::SplitMix64;
 
 /// Seconds per phase of one Lanczos run.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -76,8 +77,8 @@ impl<'a> Lanczos<'a> {
         par: Par,
     ) -> Self {
         let n = sqrt_m.len();
-        let mut rng = SplitMix64(seed);
-        let mut w = Mat::<f64>::from_fn(n, b, |_, _| rng.uniform());
+        let mut rng = SplitMix64::new(seed);
+        let mut w = Mat::<f64>::from_fn(n, b, |_, _| rng.next_signed_f64());
         // Capacity for the largest basis, but only the columns in use are touched (resident).
         let mut v = Mat::<f64>::new();
         v.reserve(n, max_basis + b);

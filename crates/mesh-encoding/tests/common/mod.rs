@@ -3,21 +3,13 @@
 
 use std::path::PathBuf;
 
-#[path = "../../../../test-support/shared_data.rs"]
-mod support;
+use test_support as support;
+#[allow(unused_imports)]
+pub use test_support::TempDir;
 
 /// The shared data folder (`$NEURAL_BRDF_DATA`, default `<workspace>/../shared/data`) when
-/// it holds `meshes/`; see `test-support/shared_data.rs`.
+/// it holds `meshes/`; see `test_support::shared_data_root`.
 #[allow(dead_code)]
 pub fn data_dir() -> Option<PathBuf> {
     support::shared_data_root("meshes")
-}
-
-/// A fresh, empty temporary directory unique to this process and `name`.
-#[allow(dead_code)]
-pub fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mesh-encoding-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("create temp dir");
-    dir
 }

@@ -113,7 +113,7 @@ fn ts_reference(ts: &TorranceSparrow<f32>, roughness: f32, l: [f32; 3]) -> ([f64
     let l64 = l.map(f64::from);
     let n = 1 << 18;
     let (mut sum, mut sq) = ([0.0f64; 3], [0.0f64; 3]);
-    let mut rng = brdf_analytic::albedo::SplitMix64::new(12345);
+    let mut rng = stdx::rng::SplitMix64::new(12345);
     for i in 0..n {
         let u0 = rng.next_f64();
         let u1 = (i as f64 + rng.next_f64()) / n as f64;

@@ -16,7 +16,6 @@
 use crate::error::{Error, Result};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// torchvision's AlexNet weights (PyTorch pickle).
@@ -72,7 +71,6 @@ pub fn read(path: &Path) -> Result<Tensors> {
 
 /// Writes a weight file (atomically: temporary file, then rename).
 pub fn write(path: &Path, tensors: &Tensors) -> Result<()> {
-    let io = |source| Error::Io { path: path.into(), source };
     let mut buf = MAGIC.to_vec();
     buf.extend_from_slice(&(tensors.len() as u32).to_le_bytes());
     for (name, (dims, data)) in tensors {
@@ -86,9 +84,7 @@ pub fn write(path: &Path, tensors: &Tensors) -> Result<()> {
             buf.extend_from_slice(&v.to_le_bytes());
         }
     }
-    let tmp = path.with_extension("tmp");
-    std::fs::File::create(&tmp).and_then(|mut f| f.write_all(&buf)).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(io)
+    Ok(stdx::fs::write_atomic(path, &buf)?)
 }
 
 /// Lower-case hex sha256 of a file.

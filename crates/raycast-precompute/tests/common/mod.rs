@@ -8,11 +8,12 @@ use std::path::PathBuf;
 use mesh_encoding::glam::Vec3;
 use mesh_encoding::{LoadOptions, TriMesh, load_mesh};
 
-#[path = "../../../../test-support/shared_data.rs"]
-mod support;
+use test_support as support;
+#[allow(unused_imports)]
+pub use test_support::TempDir;
 
 /// The shared data folder (`$NEURAL_BRDF_DATA`, default `<workspace>/../shared/data`) when
-/// it holds `meshes/`; see `test-support/shared_data.rs`.
+/// it holds `meshes/`; see `test_support::shared_data_root`.
 pub fn data_dir() -> Option<PathBuf> {
     support::shared_data_root("meshes")
 }
@@ -24,30 +25,18 @@ pub fn shared_mesh(name: &str) -> Option<TriMesh> {
     Some(load_mesh(&path, &options).unwrap_or_else(|e| panic!("{e}")).mesh)
 }
 
-/// A fresh, empty temporary directory unique to this process and `name`.
-pub fn temp_dir(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("raycast-precompute-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("create temp dir");
-    dir
-}
-
-/// A small deterministic generator (SplitMix64), enough for test directions.
-pub struct Rng(pub u64);
+/// The workspace's seeded generator with test directions on top.
+pub struct Rng(pub stdx::rng::SplitMix64);
 
 impl Rng {
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+    /// A generator from a seed.
+    pub fn new(seed: u64) -> Self {
+        Self(stdx::rng::SplitMix64::new(seed))
     }
 
     /// Uniform in [0, 1).
     pub fn uniform(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+        self.0.next_f32()
     }
 
     /// Uniform on the unit sphere.
