@@ -99,6 +99,7 @@ fn lambertian_renders_rho_over_pi_e_cos_and_shadows_are_zero() {
         report.stats
     );
     let ds = SceneDataset::open(&out).unwrap();
+    assert_eq!(ds.manifest.label, report.label, "the manifest carries the provenance label");
     let sigma = cfg.settings.noise_sigma as f64;
     let e = cfg.settings.light_intensity;
     let mut checked = 0;

@@ -182,8 +182,8 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
 
         let jobs: Vec<(usize, usize)> =
             (0..s.views).flat_map(|v| (0..s.lights_per_view).map(move |l| (v, l))).collect();
-        let label = format!("rendering {}", out.display());
-        let bar = stdx::progress::bar(jobs.len() as u64, "images", &label, progress);
+        let bar_label = format!("rendering {}", out.display());
+        let bar = stdx::progress::bar(jobs.len() as u64, "images", &bar_label, progress);
         let stats = Mutex::new(SceneStats::default());
         jobs.par_iter().try_for_each(|&(vi, li)| -> Result<()> {
             let vp = &geometry.views[vi];
