@@ -2,8 +2,8 @@
 //! with the scene generator of `dataset-merl`, skipping scenes that are already complete.
 
 use anyhow::{Context, Result};
-use dataset_merl::scene::{MaterialSpec, SceneConfig, SceneSettings};
 use dataset_merl::{CATALOGUE, generate_scene};
+use scene::{MaterialSpec, SceneConfig, SceneSettings};
 use std::path::PathBuf;
 
 /// Options of the command.

@@ -115,90 +115,113 @@ pub fn read_mask(path: &Path) -> Result<(u32, u32, Vec<bool>)> {
     Ok((w, h, img.pixels().map(|p| p.0.iter().any(|&c| c >= 128)).collect()))
 }
 
+/// Per light: a direction or an RGB intensity.
+type PerLight = Vec<[f64; 3]>;
+
+/// The light directions (unit, checked) and intensities (finite, positive) of a capture
+/// directory, one per image.
+fn read_lights(dir: &Path) -> Result<(PerLight, PerLight)> {
+    let dir_path = dir.join(LIGHT_DIRECTIONS);
+    let int_path = dir.join(LIGHT_INTENSITIES);
+    let raw_dirs = read_rows(&dir_path)?;
+    let intensities = read_rows(&int_path)?;
+    if raw_dirs.is_empty() {
+        return Err(Error::input(&dir_path, "no light directions"));
+    }
+    if raw_dirs.len() != intensities.len() {
+        return Err(Error::input(
+            &int_path,
+            format!(
+                "{} light intensities, but {} has {} directions",
+                intensities.len(),
+                LIGHT_DIRECTIONS,
+                raw_dirs.len()
+            ),
+        ));
+    }
+    for (i, e) in intensities.iter().enumerate() {
+        if e.iter().any(|c| !(c.is_finite() && *c > 0.0)) {
+            return Err(Error::input(
+                &int_path,
+                format!("light {}: intensity {e:?} must be finite and > 0 per channel", i + 1),
+            ));
+        }
+    }
+    let mut directions = Vec::with_capacity(raw_dirs.len());
+    for (i, d) in raw_dirs.iter().enumerate() {
+        let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        if !(n.is_finite() && (n - 1.0).abs() <= UNIT_TOLERANCE) {
+            return Err(Error::input(
+                &dir_path,
+                format!("light {}: direction {d:?} is not a unit vector (length {n})", i + 1),
+            ));
+        }
+        directions.push(d.map(|c| c / n));
+    }
+    Ok((directions, intensities))
+}
+
+/// The image files of `count` lights: from the file-name list when there is one, else
+/// `001.png`, `002.png`, ...
+fn image_paths(dir: &Path, count: usize) -> Result<Vec<PathBuf>> {
+    let names_path = dir.join(FILENAMES);
+    let images: Vec<PathBuf> = if names_path.is_file() {
+        let text = std::fs::read_to_string(&names_path).map_err(|e| Error::io(&names_path, e))?;
+        text.lines().map(str::trim).filter(|l| !l.is_empty()).map(|l| dir.join(l)).collect()
+    } else {
+        (1..=count).map(|i| dir.join(format!("{i:03}.png"))).collect()
+    };
+    if images.len() != count {
+        return Err(Error::input(
+            &names_path,
+            format!("{} image names, but {count} light directions", images.len()),
+        ));
+    }
+    Ok(images)
+}
+
+/// Checks that every image exists and has the mask's size (the first image's mismatch is
+/// reported against the mask).
+fn check_image_sizes(images: &[PathBuf], mask_path: &Path, width: u32, height: u32) -> Result<()> {
+    let first = &images[0];
+    if first.is_file() {
+        let (w, h) = image::image_dimensions(first).map_err(|e| image_err(first, e))?;
+        if (w, h) != (width, height) {
+            return Err(Error::input(
+                mask_path,
+                format!("{width} x {height} pixels, but the images are {w} x {h}"),
+            ));
+        }
+    }
+    for img in images {
+        if !img.is_file() {
+            return Err(Error::input(img, "image is missing"));
+        }
+        let (w, h) = image::image_dimensions(img).map_err(|e| image_err(img, e))?;
+        if (w, h) != (width, height) {
+            return Err(Error::input(
+                img,
+                format!("{w} x {h} pixels, but {MASK} is {width} x {height}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl Capture {
     /// Opens and checks a capture directory (light files, mask, and every image's header).
     pub fn open(dir: &Path) -> Result<Self> {
         if !dir.is_dir() {
             return Err(Error::input(dir, "capture directory is missing"));
         }
-        let dir_path = dir.join(LIGHT_DIRECTIONS);
-        let int_path = dir.join(LIGHT_INTENSITIES);
-        let raw_dirs = read_rows(&dir_path)?;
-        let intensities = read_rows(&int_path)?;
-        if raw_dirs.is_empty() {
-            return Err(Error::input(&dir_path, "no light directions"));
-        }
-        if raw_dirs.len() != intensities.len() {
-            return Err(Error::input(
-                &int_path,
-                format!(
-                    "{} light intensities, but {} has {} directions",
-                    intensities.len(),
-                    LIGHT_DIRECTIONS,
-                    raw_dirs.len()
-                ),
-            ));
-        }
-        for (i, e) in intensities.iter().enumerate() {
-            if e.iter().any(|c| !(c.is_finite() && *c > 0.0)) {
-                return Err(Error::input(
-                    &int_path,
-                    format!("light {}: intensity {e:?} must be finite and > 0 per channel", i + 1),
-                ));
-            }
-        }
-        let mut directions = Vec::with_capacity(raw_dirs.len());
-        for (i, d) in raw_dirs.iter().enumerate() {
-            let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            if !(n.is_finite() && (n - 1.0).abs() <= UNIT_TOLERANCE) {
-                return Err(Error::input(
-                    &dir_path,
-                    format!("light {}: direction {d:?} is not a unit vector (length {n})", i + 1),
-                ));
-            }
-            directions.push(d.map(|c| c / n));
-        }
-        let names_path = dir.join(FILENAMES);
-        let images: Vec<PathBuf> = if names_path.is_file() {
-            let text =
-                std::fs::read_to_string(&names_path).map_err(|e| Error::io(&names_path, e))?;
-            text.lines().map(str::trim).filter(|l| !l.is_empty()).map(|l| dir.join(l)).collect()
-        } else {
-            (1..=directions.len()).map(|i| dir.join(format!("{i:03}.png"))).collect()
-        };
-        if images.len() != directions.len() {
-            return Err(Error::input(
-                &names_path,
-                format!("{} image names, but {} light directions", images.len(), directions.len()),
-            ));
-        }
+        let (directions, intensities) = read_lights(dir)?;
+        let images = image_paths(dir, directions.len())?;
         let mask_path = dir.join(MASK);
         let (width, height, mask) = read_mask(&mask_path)?;
         if !mask.iter().any(|&m| m) {
             return Err(Error::input(&mask_path, "the mask is empty"));
         }
-        let first = &images[0];
-        if first.is_file() {
-            let (w, h) = image::image_dimensions(first).map_err(|e| image_err(first, e))?;
-            if (w, h) != (width, height) {
-                return Err(Error::input(
-                    &mask_path,
-                    format!("{width} x {height} pixels, but the images are {w} x {h}"),
-                ));
-            }
-        }
-        for img in &images {
-            if !img.is_file() {
-                return Err(Error::input(img, "image is missing"));
-            }
-            let (w, h) = image::image_dimensions(img).map_err(|e| image_err(img, e))?;
-            if (w, h) != (width, height) {
-                return Err(Error::input(
-                    img,
-                    format!("{w} x {h} pixels, but {MASK} is {width} x {height}"),
-                ));
-            }
-        }
+        check_image_sizes(&images, &mask_path, width, height)?;
         Ok(Self { dir: dir.into(), width, height, mask, images, directions, intensities })
     }
 

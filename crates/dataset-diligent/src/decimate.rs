@@ -282,116 +282,150 @@ impl State {
 /// checks refuse the rest; the report says how many remain). A mesh already small enough is
 /// returned unchanged (unreferenced vertices dropped).
 pub fn decimate(mesh: &TriMesh, options: &DecimateOptions) -> (TriMesh, DecimateReport) {
-    let n = mesh.positions.len();
-    let tris: Vec<[u32; 3]> = mesh
-        .triangles
-        .iter()
-        .copied()
-        .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
-        .collect();
-    let mut st = State {
-        pos: mesh.positions.iter().map(|p| p.as_dvec3()).collect(),
-        quadric: vec![Quadric::default(); n],
-        tri_dead: vec![false; tris.len()],
-        vtris: vec![Vec::new(); n],
-        stamp: vec![0; n],
-        tris,
-        cos_turn: options.max_normal_turn_deg.to_radians().cos(),
-    };
-    let mut edges: Vec<(u32, u32, u32)> = Vec::with_capacity(3 * st.tris.len());
-    for (ti, t) in st.tris.iter().enumerate() {
-        let c = (st.pos[t[1] as usize] - st.pos[t[0] as usize])
-            .cross(st.pos[t[2] as usize] - st.pos[t[0] as usize]);
-        let area = 0.5 * c.length();
-        if let Some(nrm) = c.try_normalize() {
-            let q = Quadric::plane(nrm, -nrm.dot(st.pos[t[0] as usize]), area);
-            for &v in t {
-                st.quadric[v as usize] = st.quadric[v as usize].add(&q);
-            }
-        }
-        for k in 0..3 {
-            st.vtris[t[k] as usize].push(ti as u32);
-            let (u, v) = (t[k], t[(k + 1) % 3]);
-            edges.push((u.min(v), u.max(v), ti as u32));
-        }
-    }
-    edges.sort_unstable();
-    // Boundary planes: edges with a single triangle.
-    let mut i = 0;
-    let mut unique = Vec::with_capacity(edges.len() / 2);
-    while i < edges.len() {
-        let mut j = i + 1;
-        while j < edges.len() && edges[j].0 == edges[i].0 && edges[j].1 == edges[i].1 {
-            j += 1;
-        }
-        let (u, v, t) = edges[i];
-        unique.push((u, v));
-        if j - i == 1 {
-            let tri = st.tris[t as usize];
-            let fnrm = st.normal(tri, u32::MAX, DVec3::ZERO);
-            let e = st.pos[v as usize] - st.pos[u as usize];
-            if let Some(bn) = e.cross(fnrm).try_normalize() {
-                let w = options.boundary_weight * e.length_squared();
-                let q = Quadric::plane(bn, -bn.dot(st.pos[u as usize]), w);
-                for x in [u, v] {
-                    st.quadric[x as usize] = st.quadric[x as usize].add(&q);
-                }
-            }
-        }
-        i = j;
-    }
+    let (mut st, edges) = State::new(mesh, options);
     let vertices_before = st.vtris.iter().filter(|t| !t.is_empty()).count();
     let mut report =
         DecimateReport { vertices_before, triangles_before: st.tris.len(), ..Default::default() };
-    let mut alive = vertices_before;
-    if alive > options.target_vertices {
+    let alive = st.collapse_until(vertices_before, options.target_vertices, &edges, &mut report);
+    let out = st.compact(alive);
+    report.vertices_after = out.positions.len();
+    report.triangles_after = out.triangles.len();
+    (out, report)
+}
+
+impl State {
+    /// The state of `mesh` (degenerate triangles dropped) with every vertex's quadric: its
+    /// triangles' planes weighted by area, plus the boundary planes; and the unique edges.
+    fn new(mesh: &TriMesh, options: &DecimateOptions) -> (Self, Vec<(u32, u32)>) {
+        let n = mesh.positions.len();
+        let tris: Vec<[u32; 3]> = mesh
+            .triangles
+            .iter()
+            .copied()
+            .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+            .collect();
+        let mut st = State {
+            pos: mesh.positions.iter().map(|p| p.as_dvec3()).collect(),
+            quadric: vec![Quadric::default(); n],
+            tri_dead: vec![false; tris.len()],
+            vtris: vec![Vec::new(); n],
+            stamp: vec![0; n],
+            tris,
+            cos_turn: options.max_normal_turn_deg.to_radians().cos(),
+        };
+        let mut edges: Vec<(u32, u32, u32)> = Vec::with_capacity(3 * st.tris.len());
+        for (ti, t) in st.tris.iter().enumerate() {
+            let c = (st.pos[t[1] as usize] - st.pos[t[0] as usize])
+                .cross(st.pos[t[2] as usize] - st.pos[t[0] as usize]);
+            let area = 0.5 * c.length();
+            if let Some(nrm) = c.try_normalize() {
+                let q = Quadric::plane(nrm, -nrm.dot(st.pos[t[0] as usize]), area);
+                for &v in t {
+                    st.quadric[v as usize] = st.quadric[v as usize].add(&q);
+                }
+            }
+            for k in 0..3 {
+                st.vtris[t[k] as usize].push(ti as u32);
+                let (u, v) = (t[k], t[(k + 1) % 3]);
+                edges.push((u.min(v), u.max(v), ti as u32));
+            }
+        }
+        edges.sort_unstable();
+        let unique = st.add_boundary_planes(&edges, options.boundary_weight);
+        (st, unique)
+    }
+
+    /// Adds, for every boundary edge (one with a single triangle), the plane through it
+    /// perpendicular to its triangle, weighted by `weight` times its squared length, to both
+    /// end vertices. `edges` are (min vertex, max vertex, triangle), sorted; returns the unique
+    /// edges.
+    fn add_boundary_planes(&mut self, edges: &[(u32, u32, u32)], weight: f64) -> Vec<(u32, u32)> {
+        let mut i = 0;
+        let mut unique = Vec::with_capacity(edges.len() / 2);
+        while i < edges.len() {
+            let mut j = i + 1;
+            while j < edges.len() && edges[j].0 == edges[i].0 && edges[j].1 == edges[i].1 {
+                j += 1;
+            }
+            let (u, v, t) = edges[i];
+            unique.push((u, v));
+            if j - i == 1 {
+                let tri = self.tris[t as usize];
+                let fnrm = self.normal(tri, u32::MAX, DVec3::ZERO);
+                let e = self.pos[v as usize] - self.pos[u as usize];
+                if let Some(bn) = e.cross(fnrm).try_normalize() {
+                    let w = weight * e.length_squared();
+                    let q = Quadric::plane(bn, -bn.dot(self.pos[u as usize]), w);
+                    for x in [u, v] {
+                        self.quadric[x as usize] = self.quadric[x as usize].add(&q);
+                    }
+                }
+            }
+            i = j;
+        }
+        unique
+    }
+
+    /// Collapses the cheapest allowed edges until `target` of the `alive` vertices remain (or
+    /// no candidate is left); returns the vertices alive.
+    fn collapse_until(
+        &mut self,
+        mut alive: usize,
+        target: usize,
+        edges: &[(u32, u32)],
+        report: &mut DecimateReport,
+    ) -> usize {
+        if alive <= target {
+            return alive;
+        }
         let mut heap: BinaryHeap<Candidate> =
-            unique.iter().map(|&(u, v)| st.candidate(u, v)).collect();
+            edges.iter().map(|&(u, v)| self.candidate(u, v)).collect();
         let mut scratch = [Vec::new(), Vec::new(), Vec::new()];
         let mut nbrs = Vec::new();
-        while alive > options.target_vertices {
+        while alive > target {
             let Some(c) = heap.pop() else { break };
             let (a, b) = (c.a, c.b);
-            if (st.stamp[a as usize], st.stamp[b as usize]) != c.stamps
-                || st.vtris[a as usize].is_empty()
-                || st.vtris[b as usize].is_empty()
+            if (self.stamp[a as usize], self.stamp[b as usize]) != c.stamps
+                || self.vtris[a as usize].is_empty()
+                || self.vtris[b as usize].is_empty()
             {
                 continue;
             }
-            let Some(shared) = st.allowed(a, b, c.p, &mut scratch) else {
+            let Some(shared) = self.allowed(a, b, c.p, &mut scratch) else {
                 report.refused += 1;
                 continue;
             };
-            st.collapse(a, b, c.p, &shared);
+            self.collapse(a, b, c.p, &shared);
             alive -= 1;
             report.collapses += 1;
             report.max_error = report.max_error.max(c.cost.sqrt());
-            st.neighbours(a, &mut nbrs);
+            self.neighbours(a, &mut nbrs);
             for &u in &nbrs {
-                heap.push(st.candidate(a, u));
+                heap.push(self.candidate(a, u));
             }
         }
+        alive
     }
-    // Compact.
-    let mut remap = vec![u32::MAX; n];
-    let mut positions = Vec::with_capacity(alive);
-    for (v, slot) in remap.iter_mut().enumerate() {
-        if !st.vtris[v].is_empty() {
-            *slot = positions.len() as u32;
-            positions.push(st.pos[v].as_vec3());
+
+    /// The mesh of the live vertices and triangles, vertices renumbered in order.
+    fn compact(&self, alive: usize) -> TriMesh {
+        let mut remap = vec![u32::MAX; self.pos.len()];
+        let mut positions = Vec::with_capacity(alive);
+        for (v, slot) in remap.iter_mut().enumerate() {
+            if !self.vtris[v].is_empty() {
+                *slot = positions.len() as u32;
+                positions.push(self.pos[v].as_vec3());
+            }
         }
+        let triangles: Vec<[u32; 3]> = self
+            .tris
+            .iter()
+            .zip(&self.tri_dead)
+            .filter(|(_, d)| !**d)
+            .map(|(t, _)| t.map(|v| remap[v as usize]))
+            .collect();
+        TriMesh { positions, triangles }
     }
-    let triangles: Vec<[u32; 3]> = st
-        .tris
-        .iter()
-        .zip(&st.tri_dead)
-        .filter(|(_, d)| !**d)
-        .map(|(t, _)| t.map(|v| remap[v as usize]))
-        .collect();
-    report.vertices_after = positions.len();
-    report.triangles_after = triangles.len();
-    let out = TriMesh { positions, triangles };
-    (out, report)
 }
 
 /// The decimated mesh's vertex normals, recomputed (angle-weighted), for callers that want them

@@ -38,9 +38,9 @@ pub enum Error {
         /// What is wrong with it.
         fault: String,
     },
-    /// Writing the scene directory (dataset-merl's formats) failed.
+    /// Writing the scene directory (the scene format) failed.
     #[error(transparent)]
-    Scene(#[from] dataset_merl::Error),
+    Scene(#[from] scene::Error),
     /// The mesh could not be loaded or is invalid.
     #[error(transparent)]
     Mesh(#[from] mesh_encoding::Error),

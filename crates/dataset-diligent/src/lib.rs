@@ -1,6 +1,6 @@
 //! Loaders for the real DiLiGenT (single view) and DiLiGenT-MV captures, producing the same
-//! dataset API as the semi-synthetic scenes: an importer writes a scene directory in
-//! `dataset-merl`'s format, so [`dataset_merl::SceneDataset::open`] and `samples(split)` (and
+//! dataset API as the semi-synthetic scenes: an importer writes a scene directory in the scene
+//! format, so [`scene::SceneDataset::open`] and `samples(split)` (and
 //! the experiments crate's `fit` / `eval`) read real captures with no special case.
 //!
 //! Entry points:
@@ -27,11 +27,11 @@
 //! intensity, per channel; manifest intensities are 1), no ground-truth BRDF (zero images,
 //! `GT_VALID` never set), `SATURATED` where a raw channel reaches the saturation level, `LIT`
 //! where the pixel is in the mask and the ray-cast geometry says the light reaches it; the
-//! manifest's material is [`MaterialSpec::Captured`](dataset_merl::scene::MaterialSpec).
+//! manifest's material is [`MaterialSpec::Captured`](scene::MaterialSpec).
 //!
 //! ```no_run
 //! use dataset_diligent::{SingleViewOptions, import_single_view};
-//! use dataset_merl::{SceneDataset, scene::Split};
+//! use scene::{SceneDataset, Split};
 //! let src = std::path::Path::new("../shared/data/diligent/pmsData/ballPNG");
 //! let report = import_single_view(src, "scenes/diligent-ball".as_ref(), &SingleViewOptions::default())?;
 //! println!("{} lit samples, sphere normals {:?}", report.stats.lit_samples, report.normal_check);

@@ -29,8 +29,8 @@ use crate::report::ImportReport;
 use crate::scene_writer::{CapturedScene, ViewSpec, write_scene};
 use crate::single_view::object_name;
 use crate::split::{split_lights, train_views};
-use dataset_merl::scene::manifest::Split;
 use glam::DMat3;
+use scene::Split;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -119,28 +119,17 @@ fn rows(m: DMat3) -> [[f32; 3]; 3] {
     [t.x_axis, t.y_axis, t.z_axis].map(|r| r.as_vec3().to_array())
 }
 
-/// Imports the DiLiGenT-MV object in `src` (a `mvpmsData/<obj>PNG` directory) into the scene
-/// directory `out`.
-///
-/// # Errors
-/// Bad input naming the file and the fault: a missing view, calibration variable or mesh,
-/// light counts that differ between files or views, bad intensities, images or masks of the
-/// wrong size, damaged PNG or MAT files; invalid options; failures writing the scene.
-pub fn import_multi_view(src: &Path, out: &Path, o: &MultiViewOptions) -> Result<ImportReport> {
-    let start = Instant::now();
-    if !src.is_dir() {
-        return Err(Error::input(src, "object directory is missing"));
-    }
-    let is_train = train_views(o.views, o.train_views.as_deref())?;
-    let mut captures = Vec::with_capacity(o.views);
-    for v in 1..=o.views {
+/// Opens the captures of views 1..=`views` (`view_VV/`), which must agree in light count and
+/// image size.
+fn open_views(src: &Path, views: usize) -> Result<Vec<Capture>> {
+    let mut captures: Vec<Capture> = Vec::with_capacity(views);
+    for v in 1..=views {
         let dir = src.join(format!("view_{v:02}"));
         if !dir.is_dir() {
-            return Err(Error::input(&dir, format!("view {v} of {} is missing", o.views)));
+            return Err(Error::input(&dir, format!("view {v} of {views} is missing")));
         }
         let c = Capture::open(&dir)?;
         if let Some(first) = captures.first() {
-            let first: &Capture = first;
             if c.len() != first.len() {
                 return Err(Error::input(
                     &c.dir,
@@ -163,6 +152,47 @@ pub fn import_multi_view(src: &Path, out: &Path, o: &MultiViewOptions) -> Result
         }
         captures.push(c);
     }
+    Ok(captures)
+}
+
+/// The ground-truth mesh, decimated to the target vertex count when it has more, and checked.
+fn load_decimated(
+    mesh_path: &Path,
+    o: &MultiViewOptions,
+) -> Result<(mesh_encoding::TriMesh, Option<crate::decimate::DecimateReport>)> {
+    let loaded = mesh_encoding::load_mesh(mesh_path, &mesh_encoding::LoadOptions::default())?;
+    let (mesh, decimation) = match o.target_vertices {
+        Some(target) if loaded.mesh.positions.len() > target => {
+            let message = format!("decimating {} to {target} vertices", mesh_path.display());
+            let bar = stdx::progress::spinner(&message, o.progress);
+            let (m, r) = decimate(
+                &loaded.mesh,
+                &DecimateOptions { target_vertices: target, ..Default::default() },
+            );
+            bar.finish_and_clear();
+            (m, Some(r))
+        }
+        _ => (loaded.mesh, None),
+    };
+    mesh.validate()
+        .map_err(|fault| Error::input(mesh_path, format!("after decimation: {fault}")))?;
+    Ok((mesh, decimation))
+}
+
+/// Imports the DiLiGenT-MV object in `src` (a `mvpmsData/<obj>PNG` directory) into the scene
+/// directory `out`.
+///
+/// # Errors
+/// Bad input naming the file and the fault: a missing view, calibration variable or mesh,
+/// light counts that differ between files or views, bad intensities, images or masks of the
+/// wrong size, damaged PNG or MAT files; invalid options; failures writing the scene.
+pub fn import_multi_view(src: &Path, out: &Path, o: &MultiViewOptions) -> Result<ImportReport> {
+    let start = Instant::now();
+    if !src.is_dir() {
+        return Err(Error::input(src, "object directory is missing"));
+    }
+    let is_train = train_views(o.views, o.train_views.as_deref())?;
+    let captures = open_views(src, o.views)?;
     let (train, test) = split_lights(captures[0].len(), o.train_lights, o.test_lights, o.seed)?;
 
     let calib_path = o.calibration.clone().unwrap_or_else(|| src.join("Calib_Results.mat"));
@@ -178,22 +208,7 @@ pub fn import_multi_view(src: &Path, out: &Path, o: &MultiViewOptions) -> Result
         Some(p) => p.clone(),
         None => find_mesh(src)?,
     };
-    let loaded = mesh_encoding::load_mesh(&mesh_path, &mesh_encoding::LoadOptions::default())?;
-    let (mut mesh, decimation) = match o.target_vertices {
-        Some(target) if loaded.mesh.positions.len() > target => {
-            let message = format!("decimating {} to {target} vertices", mesh_path.display());
-            let bar = stdx::progress::spinner(&message, o.progress);
-            let (m, r) = decimate(
-                &loaded.mesh,
-                &DecimateOptions { target_vertices: target, ..Default::default() },
-            );
-            bar.finish_and_clear();
-            (m, Some(r))
-        }
-        _ => (loaded.mesh, None),
-    };
-    mesh.validate()
-        .map_err(|fault| Error::input(&mesh_path, format!("after decimation: {fault}")))?;
+    let (mut mesh, decimation) = load_decimated(&mesh_path, o)?;
     let sim = mesh.normalize_unit_sphere();
     let (c, s) = (sim.center.as_dvec3(), sim.scale as f64);
 

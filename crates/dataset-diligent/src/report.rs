@@ -2,7 +2,7 @@
 //! mesh, and the shape checks (circle fit, normal error, decimation).
 
 use crate::decimate::DecimateReport;
-use dataset_merl::scene::manifest::{SceneStats, Split};
+use scene::{SceneStats, Split};
 use std::path::PathBuf;
 
 /// One view of the written scene.

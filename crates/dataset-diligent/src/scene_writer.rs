@@ -1,5 +1,5 @@
-//! Writes a captured scene in dataset-merl's scene format, so that
-//! [`dataset_merl::SceneDataset::open`] and `samples(split)` read it with no special case.
+//! Writes a captured scene in the scene format (through the scene crate's one writer), so that
+//! [`scene::SceneDataset::open`] and `samples(split)` read it with no special case.
 //!
 //! Per (view, light) of the manifest:
 //! * `images/vVV_lLL.exr`: observed radiance for unit irradiance, raw / 65535 / intensity per
@@ -14,27 +14,22 @@
 //! light), `mesh.ply`, the `geometry/` ray-casting cache (computed exactly as `open` will, so
 //! it is a cache hit there), and `manifest.json` (config with
 //! [`MaterialSpec::Captured`], cameras, world light directions with their 1-based source image
-//! numbers, file hashes, statistics). The directory is assembled under a temporary name beside
-//! the target and renamed into place when complete.
+//! numbers, file hashes, statistics).
 
 use crate::capture::{Capture, diligent_to_opencv};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::report::ViewReport;
-use dataset_merl::scene::generate::sample_stem;
-use dataset_merl::scene::manifest::{
-    FORMAT, FileEntry, LightInfo, MANIFEST_FILE, Manifest, SceneStats, Split, VERSION, ViewInfo,
-};
-use dataset_merl::scene::render::flag;
-use dataset_merl::scene::{MaterialSpec, SceneConfig, SceneSettings, UpAxis, images, mesh_file};
 use glam::{Mat3, Vec3};
 use mesh_encoding::TriMesh;
 use raycast_precompute::{
-    Camera, LightState, PrecomputeSettings, ScenePrecompute, ShadowBias, View, mat3_from_rows,
-    precompute_cached,
+    Camera, LightState, ScenePrecompute, View, ViewPrecompute, mat3_from_rows,
 };
-use rayon::prelude::*;
+use scene::flag;
+use scene::manifest::{LightInfo, Manifest, Split, ViewInfo};
+use scene::{
+    MaterialSpec, PairImages, Progress, SceneConfig, SceneContents, SceneSettings, UpAxis,
+};
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 
 /// One view to write: a camera, the capture it shows and the lights used.
 pub(crate) struct ViewSpec {
@@ -80,8 +75,9 @@ fn world_light(r: Mat3, d: [f64; 3]) -> [f32; 3] {
     (r.transpose() * Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32)).normalize().to_array()
 }
 
-/// Writes the scene into `out` (replacing what is there once complete).
-pub(crate) fn write_scene(s: &CapturedScene<'_>, out: &Path, progress: bool) -> Result<Written> {
+/// The cameras and lights of the views, as ray casting needs them and as the manifest records
+/// them (world light directions, 1-based source image numbers).
+fn views(s: &CapturedScene<'_>) -> Result<(Vec<View>, Vec<ViewInfo>)> {
     let (width, height) = (s.captures[0].width, s.captures[0].height);
     let mut views = Vec::with_capacity(s.views.len());
     let mut infos = Vec::with_capacity(s.views.len());
@@ -111,6 +107,13 @@ pub(crate) fn write_scene(s: &CapturedScene<'_>, out: &Path, progress: bool) -> 
         });
         infos.push(ViewInfo { split: v.split, k: v.k, r: v.r, t: v.t, lights });
     }
+    Ok((views, infos))
+}
+
+/// The scene description a captured scene records: the capture's image size, views, lights,
+/// field of view and camera distance, no noise, its saturation level.
+fn scene_config(s: &CapturedScene<'_>, views: &[View]) -> Result<SceneConfig> {
+    let (width, height) = (s.captures[0].width, s.captures[0].height);
     let f_y = views[0].camera.k.y_axis.y;
     let settings = SceneSettings {
         width,
@@ -137,152 +140,93 @@ pub(crate) fn write_scene(s: &CapturedScene<'_>, out: &Path, progress: bool) -> 
         merl_dir: None,
     };
     config.validate()?;
-
-    let subdirs = ["images", "brdf", "flags", "masks", "previews"];
-    stdx::fs::write_dir_atomic(out, &subdirs, |tmp: &Path| {
-        assemble(s, &config, &views, infos, tmp, progress)
-    })
+    Ok(config)
 }
 
-fn assemble(
-    s: &CapturedScene<'_>,
-    config: &SceneConfig,
-    views: &[View],
-    infos: Vec<ViewInfo>,
-    tmp: &Path,
-    progress: bool,
-) -> Result<Written> {
-    let settings = PrecomputeSettings {
-        shadow_bias: ShadowBias::Relative(s.shadow_bias_relative),
-        ..Default::default()
+/// Writes the scene into `out` (replacing what is there once complete).
+pub(crate) fn write_scene(s: &CapturedScene<'_>, out: &Path, progress: bool) -> Result<Written> {
+    let (views, infos) = views(s)?;
+    let config = scene_config(s, &views)?;
+    let contents = SceneContents {
+        config: &config,
+        generator: format!("dataset-diligent {}", env!("CARGO_PKG_VERSION")),
+        label: format!("captured ({} {})", s.benchmark, s.object),
+        mesh: &s.mesh,
+        views: &views,
+        view_infos: infos,
+        clean_renders: false,
     };
-    let (geometry, _) = precompute_cached(&s.mesh, views, &settings, &tmp.join("geometry"))?;
-    let files = Mutex::new(Vec::new());
-    let mesh_bytes = mesh_file::ply_bytes(&s.mesh);
-    let mesh_path = tmp.join("mesh.ply");
-    std::fs::write(&mesh_path, &mesh_bytes).map_err(|e| Error::io(&mesh_path, e))?;
-    files.lock().unwrap().push(FileEntry::of("mesh.ply".into(), &mesh_bytes));
-
-    // Masks: captured mask and mesh projection; per-view agreement.
-    let mut reports = Vec::with_capacity(s.views.len());
-    for (vi, (spec, g)) in s.views.iter().zip(&geometry.views).enumerate() {
-        let cap = &s.captures[spec.capture];
+    let mask = |vi: usize, g: &ViewPrecompute| {
+        let cap = &s.captures[s.views[vi].capture];
         let mut mask = vec![0u8; cap.mask.len()];
-        let mut both = 0;
         for &p in &g.pixels {
             if cap.mask[p as usize] {
                 mask[p as usize] = 255;
-                both += 1;
             }
         }
-        let rel = format!("masks/v{vi:02}.png");
-        let bytes = images::write_png_gray(&tmp.join(&rel), g.width, g.height, &mask)?;
-        files.lock().unwrap().push(FileEntry::of(rel, &bytes));
-        reports.push(ViewReport {
-            source: cap.dir.clone(),
-            split: spec.split,
-            lights: spec.lights.iter().map(|&i| i as u32 + 1).collect(),
-            mask_pixels: cap.mask.iter().filter(|&&m| m).count() as u64,
-            mesh_pixels: g.len() as u64,
-            both_pixels: both,
-        });
-    }
-
-    let jobs: Vec<(usize, usize)> = s
+        mask
+    };
+    let message = format!("importing {} {}", s.benchmark, s.object);
+    let progress = Progress { label: &message, visible: progress };
+    let pair = |vi, li, g: &ViewPrecompute| pair_images(s, vi, li, g);
+    let written = scene::write_scene(out, contents, mask, pair, progress)?;
+    let reports = s
         .views
         .iter()
-        .enumerate()
-        .flat_map(|(vi, v)| (0..v.lights.len()).map(move |li| (vi, li)))
+        .zip(&written.geometry.views)
+        .map(|(spec, g)| view_report(&s.captures[spec.capture], spec, g))
         .collect();
-    let message = format!("importing {} {}", s.benchmark, s.object);
-    let bar = stdx::progress::bar(jobs.len() as u64, "images", &message, progress);
-    let stats = Mutex::new(SceneStats::default());
-    jobs.par_iter().try_for_each(|&(vi, li)| -> Result<()> {
-        let spec = &s.views[vi];
-        let cap = &s.captures[spec.capture];
-        let img_index = spec.lights[li];
-        let raw = cap.raw_image(img_index)?;
-        let g = &geometry.views[vi];
-        let n_pix = raw.len();
-        let mut observed = vec![[0.0_f32; 3]; n_pix];
-        for (p, o) in observed.iter_mut().enumerate() {
-            if cap.mask[p] {
-                *o = cap.radiance(img_index, raw[p]);
-            }
-        }
-        let mut flags = vec![0u8; n_pix];
-        let l = g.lights[li];
-        let mut st = SceneStats::default();
-        for k in 0..g.len() {
-            let p = g.pixels[k] as usize;
-            if !cap.mask[p] {
-                continue;
-            }
-            let n = g.normals[k];
-            let mut f = match g.visibility.get(k, li) {
-                LightState::Lit if n.dot(l) > 0.0 && n.dot(g.view_dirs[k]) > 0.0 => flag::LIT,
-                LightState::Shadowed => flag::SHADOWED,
-                _ => flag::BACK_FACING,
-            };
-            if raw[p].iter().any(|&c| c >= s.saturation_level) {
-                f |= flag::SATURATED;
-            }
-            st.lit_samples += u64::from(f & flag::LIT != 0);
-            st.shadowed_samples += u64::from(f & flag::SHADOWED != 0);
-            st.back_facing_samples += u64::from(f & flag::BACK_FACING != 0);
-            st.saturated_samples += u64::from(f & flag::SATURATED != 0);
-            flags[p] = f;
-        }
-        st.invalid_gt_samples = st.lit_samples;
-        let (w, h) = (g.width, g.height);
-        let stem = sample_stem(vi, li);
-        let zeros = vec![[0.0_f32; 3]; n_pix];
-        let mut entries = Vec::with_capacity(4);
-        for (dir, data) in [("images", &observed), ("brdf", &zeros)] {
-            let rel = format!("{dir}/{stem}.exr");
-            let bytes = images::write_exr_rgb(&tmp.join(&rel), w as usize, h as usize, data)?;
-            entries.push(FileEntry::of(rel, &bytes));
-        }
-        let rel = format!("flags/{stem}.png");
-        let bytes = images::write_png_gray(&tmp.join(&rel), w, h, &flags)?;
-        entries.push(FileEntry::of(rel, &bytes));
-        if li == 0 {
-            let rel = format!("previews/v{vi:02}.png");
-            let bytes = images::write_png_srgb(&tmp.join(&rel), w, h, &observed)?;
-            entries.push(FileEntry::of(rel, &bytes));
-        }
-        files.lock().unwrap().extend(entries);
-        let mut all = stats.lock().unwrap();
-        all.lit_samples += st.lit_samples;
-        all.shadowed_samples += st.shadowed_samples;
-        all.back_facing_samples += st.back_facing_samples;
-        all.saturated_samples += st.saturated_samples;
-        all.invalid_gt_samples += st.invalid_gt_samples;
-        bar.inc(1);
-        Ok(())
-    })?;
-    bar.finish_and_clear();
+    Ok(Written { manifest: written.manifest, geometry: written.geometry, views: reports })
+}
 
-    let mut stats = stats.into_inner().unwrap();
-    stats.foreground_pixels = reports.iter().map(|r| r.both_pixels).sum();
-    stats.update_saturated_fraction();
-    let mut files = files.into_inner().unwrap();
-    files.sort_by(|a, b| a.path.cmp(&b.path));
-    let mut manifest = Manifest {
-        format: FORMAT.into(),
-        version: VERSION,
-        generator: format!("dataset-diligent {}", env!("CARGO_PKG_VERSION")),
-        label: format!("captured ({} {})", s.benchmark, s.object),
-        config: config.clone(),
-        mesh_file: "mesh.ply".into(),
-        mesh_vertices: s.mesh.positions.len(),
-        mesh_triangles: s.mesh.triangles.len(),
-        views: infos,
-        files,
-        stats,
-        checksum: String::new(),
-    };
-    let json = manifest.to_json();
-    stdx::fs::write_atomic(&tmp.join(MANIFEST_FILE), json.as_bytes())?;
-    Ok(Written { manifest, geometry, views: reports })
+/// How the view's captured mask and the mesh's projection agree.
+fn view_report(cap: &Capture, spec: &ViewSpec, g: &ViewPrecompute) -> ViewReport {
+    ViewReport {
+        source: cap.dir.clone(),
+        split: spec.split,
+        lights: spec.lights.iter().map(|&i| i as u32 + 1).collect(),
+        mask_pixels: cap.mask.iter().filter(|&&m| m).count() as u64,
+        mesh_pixels: g.len() as u64,
+        both_pixels: g.pixels.iter().filter(|&&p| cap.mask[p as usize]).count() as u64,
+    }
+}
+
+/// The images of light `li` of view `vi`: the captured radiance inside the mask, zero BRDF, and
+/// the flags of the ray-cast geometry where mask and mesh agree.
+fn pair_images(
+    s: &CapturedScene<'_>,
+    vi: usize,
+    li: usize,
+    g: &ViewPrecompute,
+) -> Result<PairImages> {
+    let spec = &s.views[vi];
+    let cap = &s.captures[spec.capture];
+    let img_index = spec.lights[li];
+    let raw = cap.raw_image(img_index)?;
+    let n_pix = raw.len();
+    let mut observed = vec![[0.0_f32; 3]; n_pix];
+    for (p, o) in observed.iter_mut().enumerate() {
+        if cap.mask[p] {
+            *o = cap.radiance(img_index, raw[p]);
+        }
+    }
+    let mut flags = vec![0u8; n_pix];
+    let l = g.lights[li];
+    for k in 0..g.len() {
+        let p = g.pixels[k] as usize;
+        if !cap.mask[p] {
+            continue;
+        }
+        let n = g.normals[k];
+        let mut f = match g.visibility.get(k, li) {
+            LightState::Lit if n.dot(l) > 0.0 && n.dot(g.view_dirs[k]) > 0.0 => flag::LIT,
+            LightState::Shadowed => flag::SHADOWED,
+            _ => flag::BACK_FACING,
+        };
+        if raw[p].iter().any(|&c| c >= s.saturation_level) {
+            f |= flag::SATURATED;
+        }
+        flags[p] = f;
+    }
+    Ok(PairImages { observed, brdf: vec![[0.0; 3]; n_pix], clean: None, flags })
 }

@@ -18,8 +18,8 @@ use crate::normal_check::{read_normal_map, summarize, view_errors};
 use crate::report::ImportReport;
 use crate::scene_writer::{CapturedScene, ViewSpec, write_scene};
 use crate::split::split_lights;
-use dataset_merl::scene::manifest::Split;
 use glam::{DMat3, Mat3};
+use scene::Split;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 

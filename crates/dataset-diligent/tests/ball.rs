@@ -6,8 +6,8 @@ mod common;
 
 use dataset_diligent::mat5::{MatClass, MatFile, NumericClass};
 use dataset_diligent::{SingleViewOptions, import_single_view};
-use dataset_merl::SceneDataset;
-use dataset_merl::scene::{MaterialSpec, Split};
+use scene::SceneDataset;
+use scene::{MaterialSpec, Split};
 
 #[test]
 fn normal_gt_mat_reads_as_a_unit_normal_map() {
@@ -77,7 +77,7 @@ fn ball_imports_into_the_common_dataset_api() {
         train.len(),
         test.len()
     );
-    let ids = |s: &dataset_merl::SampleSet, v: usize| -> Vec<u32> {
+    let ids = |s: &scene::SampleSet, v: usize| -> Vec<u32> {
         let view = &ds.manifest.views[v];
         let mut ids: Vec<u32> =
             s.light.iter().map(|&l| view.lights[l as usize].source_index.unwrap()).collect();

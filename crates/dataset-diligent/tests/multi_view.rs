@@ -8,8 +8,8 @@ mod common;
 
 use common::miniature;
 use dataset_diligent::{MultiViewOptions, import_multi_view};
-use dataset_merl::SceneDataset;
-use dataset_merl::scene::{MaterialSpec, Split};
+use scene::SceneDataset;
+use scene::{MaterialSpec, Split};
 
 fn options() -> MultiViewOptions {
     MultiViewOptions {

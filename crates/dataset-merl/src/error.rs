@@ -29,36 +29,12 @@ pub enum Error {
         /// What is wrong.
         fault: String,
     },
-    /// A scene configuration value is invalid.
-    #[error("scene configuration: `{key}` {fault}")]
-    Config {
-        /// The offending key.
-        key: String,
-        /// What is wrong with it.
-        fault: String,
-    },
-    /// A dataset directory does not match its manifest, or the manifest is malformed.
-    #[error("{path}: {fault}")]
-    Dataset {
-        /// The manifest or data file.
-        path: PathBuf,
-        /// What is wrong.
-        fault: String,
-    },
-    /// An image file could not be encoded or decoded.
-    #[error("{path}: image error: {fault}")]
-    Image {
-        /// The image file.
-        path: PathBuf,
-        /// What is wrong.
-        fault: String,
-    },
     /// The mesh could not be loaded.
     #[error(transparent)]
     Mesh(#[from] mesh_encoding::Error),
-    /// Ray casting or its cache failed.
+    /// The scene format: configuration, orbit, writing or reading a scene directory.
     #[error(transparent)]
-    Raycast(#[from] raycast_precompute::Error),
+    Scene(#[from] scene::Error),
     /// A material name that the catalogue does not know.
     #[error("unknown material `{name}`; known materials: {known}")]
     UnknownMaterial {

@@ -1,5 +1,6 @@
 //! The MERL BRDF format (spec section 1), the MERL-derived material catalogue, and the
-//! semi-synthetic scene generator with the dataset API training reads.
+//! semi-synthetic scene generator, which renders them into the scene format (the `scene`
+//! crate, which also reads scenes back for training).
 //!
 //! * [`merl`]: the real binary format (reader, validating parser, atomic writer), lookup by
 //!   Rusinkiewicz angles or directions with the reference nearest-lower-bin rule or trilinear
@@ -9,8 +10,9 @@
 //! * [`catalogue`]: the 25 materials the project uses, shipped as NBRDF networks (MIT); real
 //!   MERL binaries from a configured directory take precedence. Results made from the networks
 //!   are labelled "MERL-derived (NBRDF)".
-//! * [`scene`]: semi-synthetic scenes: generation into a self-describing directory (EXR images,
-//!   masks, ground-truth BRDF, flags, manifest) and [`SceneDataset`] to read them back.
+//! * [`generate`]: [`generate_scene`], mesh + material + seed + settings -> a scene directory
+//!   (orbit cameras, seeded splits, noise), skipped when already complete.
+//! * [`render`]: one (view, light) image: radiance, ground truth, flags, noise, saturation.
 //!
 //! ```
 //! use dataset_merl::{Lookup, load_material};
@@ -23,13 +25,14 @@
 
 pub mod catalogue;
 mod error;
+pub mod generate;
 pub mod merl;
 pub mod nbrdf;
-pub mod scene;
+pub mod render;
 
 pub use catalogue::{CATALOGUE, Material, MaterialClass, MaterialSource, load_material};
 pub use error::{Error, Result};
+pub use generate::{GenerateReport, generate_scene};
 pub use merl::lookup::MerlMaterial;
 pub use merl::{Lookup, MerlBrdf};
 pub use nbrdf::Nbrdf;
-pub use scene::{SampleSet, SceneConfig, SceneDataset, generate_scene};

@@ -8,9 +8,10 @@
 mod common;
 
 use common::TempDir;
-use dataset_merl::scene::manifest::Split;
-use dataset_merl::scene::{MaterialSpec, SceneConfig, SceneSettings};
-use dataset_merl::{SceneDataset, generate_scene};
+use dataset_merl::generate_scene;
+use scene::SceneDataset;
+use scene::Split;
+use scene::{MaterialSpec, SceneConfig, SceneSettings};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -139,7 +140,7 @@ fn lambertian_renders_rho_over_pi_e_cos_and_shadows_are_zero() {
             let flags = ds.flags_image(v, li).unwrap();
             let img = ds.observed_image(v, li).unwrap();
             for (f, p) in flags.iter().zip(&img) {
-                if f & dataset_merl::scene::render::flag::SHADOWED != 0 {
+                if f & scene::flag::SHADOWED != 0 {
                     shadowed += 1;
                     assert!(p.iter().all(|x| (*x as f64).abs() < 6.0 * sigma), "{p:?}");
                 }

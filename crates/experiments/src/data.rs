@@ -2,7 +2,7 @@
 //! weight E cos(theta_l) and the gamma-encoded observation of every lit sample, and the
 //! gathering of a batch from random indices.
 //!
-//! Only lit samples reach this point ([`dataset_merl::SceneDataset::samples`] leaves out
+//! Only lit samples reach this point ([`scene::SceneDataset::samples`] leaves out
 //! shadowed and back-facing ones: they carry no information about the BRDF); samples whose
 //! cosine is not positive are dropped here as well.
 
@@ -10,13 +10,13 @@ use crate::config::{FeatureConfig, SpatialKind};
 use crate::loss::srgb_oetf;
 use crate::{Error, Result};
 use angles::Frame;
-use dataset_merl::scene::Split;
-use dataset_merl::scene::render::light_weight;
-use dataset_merl::{SampleSet, SceneDataset};
 use mesh_encoding::{EigenSettings, LboEncoding, cached_eigenpairs};
 use rand::SeedableRng;
 use rand::rngs::StdRng;
 use rand::seq::SliceRandom;
+use scene::Split;
+use scene::shading::light_weight;
+use scene::{SampleSet, SceneDataset};
 use std::collections::HashSet;
 use std::path::Path;
 
@@ -237,12 +237,16 @@ pub fn spatial_features(
 }
 
 /// The per-vertex LBO feature table `[vertices, dim]` of the scene's mesh, from
-/// `<cache_dir>/lbo-table-<mesh and solver key>-<selection>.f32` or computed (then cached).
+/// `<cache_dir>/lbo-table-<mesh and solver key>-<selection>.bin` (the workspace's checked cache
+/// container) or computed (then cached).
 pub fn lbo_table(
     scene: &SceneDataset,
     features: &FeatureConfig,
     cache_dir: &Path,
 ) -> Result<(Vec<f32>, usize)> {
+    /// Version of the table files; bump when the table's meaning changes.
+    const TABLE_VERSION: u32 = 1;
+    const MAGIC: &[u8; 8] = b"NBLBOTAB";
     let sel = &features.lbo;
     let config = sel.encoding()?;
     let vertices: Vec<[f64; 3]> =
@@ -254,20 +258,19 @@ pub fn lbo_table(
         &eigen_settings(features),
     );
     let path = cache_dir.join(format!(
-        "lbo-table-{key:032x}-{}-{}-{}-{}.f32",
+        "lbo-table-{key:032x}-{}-{}-{}-{}.bin",
         sel.first, sel.blocks, sel.block_len, sel.k_max
     ));
     let dim = sel.dim();
     if let Ok(bytes) = std::fs::read(&path)
-        && bytes.len() == vertices.len() * dim * 4
+        && let Ok(table) = stdx::cache_file::decode::<Vec<f32>>(&bytes, MAGIC, TABLE_VERSION, key)
+        && table.len() == vertices.len() * dim
     {
-        let table = bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]));
-        return Ok((table.collect(), dim));
+        return Ok((table, dim));
     }
     let encoding = lbo_encoding(scene, features, cache_dir)?;
     let table = encoding.as_slice().to_vec();
-    let bytes: Vec<u8> = table.iter().flat_map(|v| v.to_le_bytes()).collect();
-    stdx::fs::write_atomic(&path, &bytes)?;
+    stdx::fs::write_atomic(&path, &stdx::cache_file::encode(MAGIC, TABLE_VERSION, key, &table))?;
     Ok((table, encoding.dim()))
 }
 

@@ -38,9 +38,15 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
-    /// The dataset could not be opened or read.
+    /// The MERL catalogue or the scene generator failed.
     #[error(transparent)]
     Dataset(#[from] dataset_merl::Error),
+    /// A figure could not be drawn.
+    #[error(transparent)]
+    Report(#[from] report::Error),
+    /// A scene directory could not be read or written.
+    #[error(transparent)]
+    Scene(#[from] scene::Error),
     /// The LBO encoding failed.
     #[error(transparent)]
     Encoding(#[from] mesh_encoding::Error),

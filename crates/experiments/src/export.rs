@@ -15,10 +15,11 @@ use crate::data::{TrainingData, lbo_table};
 use crate::eval::{FittedRun, ModelBrdf};
 use crate::{Error, Result};
 use angles::Rusinkiewicz;
+use dataset_merl::MerlBrdf;
 use dataset_merl::merl::format::TABLE_LEN;
 use dataset_merl::merl::lookup::bin_lower_edges;
-use dataset_merl::{MerlBrdf, SceneDataset};
 use metrics::BatchBrdf;
+use scene::SceneDataset;
 use std::path::Path;
 
 /// Which surface point the table describes.

@@ -1,4 +1,5 @@
-//! Training, evaluation, run directories, result tables and figures (spec sections 6 and 7).
+//! Training, evaluation, run directories and sweeps (spec sections 6 and 7); the sweep's
+//! `collect` turns evaluated runs into the report crate's tables and figures.
 //!
 //! * [`config`]: the run configuration (TOML), profiles and validation.
 //! * [`data`]: the lit training records (spatial features, local directions, E cos) and batches.
@@ -11,7 +12,6 @@
 //! * [`eval`]: test renders, maps and every metric of a finished run.
 //! * [`export`]: a fitted model as a MERL-format table at one surface point.
 //! * [`sweep`]: profiles, content-addressed runs, parallel / cluster execution, `collect`.
-//! * [`report`]: result tables (Markdown, LaTeX) and figures (PNG) from evaluated runs.
 //!
 //! The binary `experiments` wraps these as `fit` and `eval` (`experiments --help`):
 //!
@@ -39,7 +39,6 @@ pub mod eval;
 pub mod export;
 pub mod loss;
 pub mod plateau;
-pub mod report;
 pub mod run_dir;
 pub mod sweep;
 pub mod train;

@@ -9,7 +9,7 @@ use experiments::eval::EnergyEstimator;
 use experiments::export::SurfacePoint;
 use experiments::run_dir::RunDir;
 use experiments::{FitOptions, FitOutcome};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Neural BRDF experiments: training and evaluation.
 #[derive(Parser)]
@@ -104,48 +104,7 @@ enum Command {
 fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Fit { config, scene, out, cache, quiet } => {
-            let stored = RunDir::new(&out).config();
-            let path = match config {
-                Some(p) => p,
-                None if stored.is_file() => stored,
-                None => bail!("--config is required for a new run ({} has none)", out.display()),
-            };
-            let mut cfg = RunConfig::read(&path)?;
-            if let Some(scene) = scene {
-                cfg.scene = Some(std::path::absolute(&scene).unwrap_or(scene));
-            }
-            let options = FitOptions { progress: !quiet, cache_dir: cache, ..Default::default() };
-            match experiments::fit(&cfg, &out, options)
-                .with_context(|| format!("fit into {}", out.display()))?
-            {
-                FitOutcome::AlreadyFinished(m) => {
-                    println!("{}: already finished ({} steps), skipped", out.display(), m.steps)
-                }
-                FitOutcome::Finished { metrics: m, resumed_from } => {
-                    if resumed_from > 0 {
-                        println!("resumed from step {resumed_from}");
-                    }
-                    let why = match m.stop_reason {
-                        Some(experiments::plateau::StopReason::Plateau) => "converged",
-                        _ => "step budget reached",
-                    };
-                    let val = match (m.best_val_loss, m.val_loss_floor) {
-                        (Some(v), Some(f)) => format!(", validation {v:.4e} (noise floor {f:.4e})"),
-                        (Some(v), None) => format!(", validation {v:.4e}"),
-                        _ => String::new(),
-                    };
-                    println!(
-                        "{}: {} after {} steps in {:.1} s, {:.0} samples/s, final loss {:.4e}{val}",
-                        out.display(),
-                        why,
-                        m.steps,
-                        m.wall_seconds,
-                        m.samples_per_second,
-                        m.final_train_loss
-                    );
-                }
-                FitOutcome::Stopped(step) => println!("stopped after step {step}"),
-            }
+            fit_command(config, scene, &out, cache, quiet)?;
         }
         Command::Eval { run, scene, cache, quiet } => {
             let metrics = experiments::eval::eval(&run, scene.as_deref(), cache.as_deref(), !quiet)
@@ -184,6 +143,60 @@ fn main() -> Result<()> {
                 e.seconds
             );
         }
+    }
+    Ok(())
+}
+
+/// `experiments fit`: the configuration from `--config` or the run directory, the scene from
+/// `--scene` when given; prints how the fit ended.
+fn fit_command(
+    config: Option<PathBuf>,
+    scene: Option<PathBuf>,
+    out: &Path,
+    cache: Option<PathBuf>,
+    quiet: bool,
+) -> Result<()> {
+    let stored = RunDir::new(out).config();
+    let path = match config {
+        Some(p) => p,
+        None if stored.is_file() => stored,
+        None => bail!("--config is required for a new run ({} has none)", out.display()),
+    };
+    let mut cfg = RunConfig::read(&path)?;
+    if let Some(scene) = scene {
+        cfg.scene = Some(std::path::absolute(&scene).unwrap_or(scene));
+    }
+    let options = FitOptions { progress: !quiet, cache_dir: cache, ..Default::default() };
+    match experiments::fit(&cfg, out, options)
+        .with_context(|| format!("fit into {}", out.display()))?
+    {
+        FitOutcome::AlreadyFinished(m) => {
+            println!("{}: already finished ({} steps), skipped", out.display(), m.steps)
+        }
+        FitOutcome::Finished { metrics: m, resumed_from } => {
+            if resumed_from > 0 {
+                println!("resumed from step {resumed_from}");
+            }
+            let why = match m.stop_reason {
+                Some(experiments::plateau::StopReason::Plateau) => "converged",
+                _ => "step budget reached",
+            };
+            let val = match (m.best_val_loss, m.val_loss_floor) {
+                (Some(v), Some(f)) => format!(", validation {v:.4e} (noise floor {f:.4e})"),
+                (Some(v), None) => format!(", validation {v:.4e}"),
+                _ => String::new(),
+            };
+            println!(
+                "{}: {} after {} steps in {:.1} s, {:.0} samples/s, final loss {:.4e}{val}",
+                out.display(),
+                why,
+                m.steps,
+                m.wall_seconds,
+                m.samples_per_second,
+                m.final_train_loss
+            );
+        }
+        FitOutcome::Stopped(step) => println!("stopped after step {step}"),
     }
     Ok(())
 }

@@ -25,9 +25,9 @@ use brdf_neural::BrdfModel;
 use burn::module::Module;
 use burn::optim::AdamConfig;
 use burn::tensor::Device;
-use dataset_merl::SceneDataset;
-use dataset_merl::scene::Split;
 use indicatif::ProgressBar;
+use scene::SceneDataset;
+use scene::Split;
 use std::path::{Path, PathBuf};
 
 pub use crate::trainer::StepHook;
@@ -43,6 +43,9 @@ pub struct FitOptions {
     pub stop_after: Option<u64>,
     /// Called before each step.
     pub hook: Option<StepHook>,
+    /// The configuration is the one just read from the run directory's own `config.toml` (a
+    /// sweep's run): it is not read again to compare.
+    pub config_from_run_dir: bool,
 }
 
 /// How [`fit`] ended.
@@ -59,6 +62,15 @@ pub enum FitOutcome {
     AlreadyFinished(RunMetrics),
     /// Stopped by [`FitOptions::stop_after`] after this many steps.
     Stopped(u64),
+}
+
+/// What a fit that trained to the end hands to evaluation in the same process, so that
+/// neither the weights nor the scene are read back from disk.
+pub struct Trained {
+    /// The fitted model in inference mode, on the CPU device.
+    pub model: BrdfModel,
+    /// The scene it was trained on, opened and verified once.
+    pub scene: SceneDataset,
 }
 
 /// The records a run trains and validates on.
@@ -102,10 +114,19 @@ pub fn training_data(config: &RunConfig, cache_dir: &Path) -> Result<RunData> {
 }
 
 /// Checks a run directory against `config`: a new run writes the config; an existing one must
-/// hold the same configuration. Returns the finished run's metrics, if finished.
-fn prepare_run_dir(config: &RunConfig, run: &RunDir) -> Result<Option<RunMetrics>> {
+/// hold the same configuration (unless `config` was just read from it). Returns the finished
+/// run's metrics, if finished.
+fn prepare_run_dir(
+    config: &RunConfig,
+    run: &RunDir,
+    from_run_dir: bool,
+) -> Result<Option<RunMetrics>> {
     let path = run.config();
-    if path.is_file() {
+    if from_run_dir {
+        if run.is_trained() {
+            return Ok(Some(RunMetrics::read(&run.metrics())?));
+        }
+    } else if path.is_file() {
         let existing = RunConfig::read(&path)?;
         if existing != *config {
             let keys = differing_keys(&existing, config);
@@ -153,14 +174,24 @@ fn differing_keys(a: &RunConfig, b: &RunConfig) -> Vec<String> {
 
 /// Trains `config` into `run` (created if needed; resumed from its last checkpoint).
 pub fn fit(config: &RunConfig, run: &Path, options: FitOptions) -> Result<FitOutcome> {
+    fit_and_keep(config, run, options).map(|(outcome, _)| outcome)
+}
+
+/// [`fit`], also handing back the model and its scene when it trained to the end (`None` for a
+/// run that was already finished or was stopped).
+pub fn fit_and_keep(
+    config: &RunConfig,
+    run: &Path,
+    options: FitOptions,
+) -> Result<(FitOutcome, Option<Trained>)> {
     config.validate()?;
     std::fs::create_dir_all(run).map_err(|e| Error::io(run, e))?;
     let dir = RunDir::new(run);
-    if let Some(metrics) = prepare_run_dir(config, &dir)? {
-        return Ok(FitOutcome::AlreadyFinished(metrics));
+    if let Some(metrics) = prepare_run_dir(config, &dir, options.config_from_run_dir)? {
+        return Ok((FitOutcome::AlreadyFinished(metrics), None));
     }
     let cache = dir.cache(config, options.cache_dir.as_deref());
-    let RunData { train: data, val, val_floor, .. } = training_data(config, &cache)?;
+    let RunData { scene, train: data, val, val_floor } = training_data(config, &cache)?;
     let t = &config.train;
 
     let device = brdf_neural::device::cpu_training();
@@ -182,7 +213,7 @@ pub fn fit(config: &RunConfig, run: &Path, options: FitOptions) -> Result<FitOut
         lp.run(model, &mut optim, state, last_checkpoint, options.hook, options.stop_after)?;
     let (model, state) = match end {
         LoopEnd::Done(done) => *done,
-        LoopEnd::Interrupted(step) => return Ok(FitOutcome::Stopped(step)),
+        LoopEnd::Interrupted(step) => return Ok((FitOutcome::Stopped(step), None)),
     };
     lp.bar.finish_with_message(if state.stopped.is_some_and(|r| r.converged()) {
         format!("converged after {} steps", state.step)
@@ -193,7 +224,8 @@ pub fn fit(config: &RunConfig, run: &Path, options: FitOptions) -> Result<FitOut
     let mut metrics = run_metrics(config, &state, &data, val.len());
     metrics.val_loss_floor = val_floor;
     metrics.write(&dir.metrics())?;
-    Ok(FitOutcome::Finished { metrics, resumed_from })
+    let trained = Trained { model: model.valid(), scene };
+    Ok((FitOutcome::Finished { metrics, resumed_from }, Some(trained)))
 }
 
 /// The training progress bar over the step budget, at `position` (hidden unless `visible`).

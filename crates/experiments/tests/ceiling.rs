@@ -3,11 +3,11 @@
 //! (the noise-free renders against the observations) to 1e-6 dB on every metric, and +inf dB
 //! against the noise-free renders; a model off by a few percent scores below the ceiling.
 
-use dataset_merl::SceneDataset;
-use dataset_merl::scene::{MaterialSpec, SceneConfig, SceneSettings, Split};
 use experiments::data::TrainingData;
 use experiments::eval::Prediction;
 use experiments::eval::images::{RenderOptions, render_and_score};
+use scene::SceneDataset;
+use scene::{MaterialSpec, SceneConfig, SceneSettings, Split};
 
 use test_support::TempDir;
 
@@ -70,7 +70,7 @@ fn scenes_of_the_old_format_ask_to_be_regenerated() {
     // Rewrite the manifest as version 1 (checksum recomputed: a valid old manifest).
     let mut m = scene.manifest.clone();
     m.version = 1;
-    let path = scene.dir.join(dataset_merl::scene::manifest::MANIFEST_FILE);
+    let path = scene.dir.join(scene::MANIFEST_FILE);
     std::fs::write(&path, m.to_json()).unwrap();
     let err = SceneDataset::open(&scene.dir).err().expect("version 1 is refused").to_string();
     assert!(err.contains("version 1") && err.contains("regenerate"), "{err}");

@@ -6,9 +6,9 @@
 
 use burn::module::{ModuleMapper, Param};
 use burn::tensor::Tensor;
-use dataset_merl::scene::{MaterialSpec, SceneConfig, SceneSettings};
 use experiments::run_dir::RunDir;
 use experiments::{Error, FitOptions, FitOutcome, RunConfig, fit};
+use scene::{MaterialSpec, SceneConfig, SceneSettings};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;

@@ -252,6 +252,26 @@ fn monte_carlo_group(
         .collect()
 }
 
+/// The replicas' estimates (running sums `s` over `m` points each, so sum / m) -> their mean
+/// and its standard error, per channel.
+fn replica_estimate(s: &[[f64; 3]], m: usize) -> ([f64; 3], [f64; 3]) {
+    let r = s.len() as f64;
+    let mut e = [0.0; 3];
+    let mut se = [0.0; 3];
+    for c in 0..3 {
+        let vals: Vec<f64> = s.iter().map(|x| x[c] / m as f64).collect();
+        let mean = vals.iter().sum::<f64>() / r;
+        let var = if s.len() > 1 {
+            vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (r - 1.0)
+        } else {
+            0.0
+        };
+        e[c] = mean;
+        se[c] = (var / r).sqrt();
+    }
+    (e, se)
+}
+
 fn sobol_group(
     brdf: &impl BatchBrdf,
     pairs: &[(usize, EnergyPair)],
@@ -273,24 +293,6 @@ fn sobol_group(
     let mut sums = vec![vec![[0.0f64; 3]; replicas]; np];
     let mut points = vec![0usize; np];
     let mut result: Vec<Option<PairEnergy>> = vec![None; np];
-    // Replica estimates (sum / m) -> their mean and standard error.
-    let estimate = |s: &[[f64; 3]], m: usize| -> ([f64; 3], [f64; 3]) {
-        let r = s.len() as f64;
-        let mut e = [0.0; 3];
-        let mut se = [0.0; 3];
-        for c in 0..3 {
-            let vals: Vec<f64> = s.iter().map(|x| x[c] / m as f64).collect();
-            let mean = vals.iter().sum::<f64>() / r;
-            let var = if s.len() > 1 {
-                vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (r - 1.0)
-            } else {
-                0.0
-            };
-            e[c] = mean;
-            se[c] = (var / r).sqrt();
-        }
-        (e, se)
-    };
     loop {
         let active: Vec<usize> = (0..np).filter(|&j| result[j].is_none()).collect();
         if active.is_empty() {
@@ -327,7 +329,7 @@ fn sobol_group(
             }
         }
         for &j in &active {
-            let (energy, std_error) = estimate(&sums[j], points[j]);
+            let (energy, std_error) = replica_estimate(&sums[j], points[j]);
             let settled = (0..3).all(|c| std_error[c] <= tol || energy[c] + z * std_error[c] < 1.0);
             if settled || points[j] >= max_points {
                 let evaluations = points[j] * replicas * COMPONENTS;

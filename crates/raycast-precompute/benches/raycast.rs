@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use mesh_encoding::{LoadOptions, TriMesh, load_mesh};
-use raycast_precompute::scenes::orbit_views;
+use raycast_precompute::rig::orbit_views;
 use raycast_precompute::{PrecomputeSettings, Tracer, precompute_with_tracer};
 
 fn mesh(name: &str) -> Option<TriMesh> {
@@ -29,7 +29,7 @@ fn bench(c: &mut Criterion) {
     for name in ["stanford-bunny.obj", "ogre.obj"] {
         let Some(mesh) = mesh(name) else { continue };
         let tracer = Tracer::new(&mesh);
-        let views = orbit_views(1, 42, 512, 2.6, 45.0, 11);
+        let views = orbit_views(1, 42, (512, 512), 2.6, 45.0, 11).unwrap();
         let settings = PrecomputeSettings::default();
         let stats = precompute_with_tracer(&tracer, &views, &settings).unwrap().stats;
         group.throughput(Throughput::Elements(stats.primary_rays + stats.shadow_rays));

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use mesh_encoding::{LoadOptions, load_mesh};
-use raycast_precompute::scenes::orbit_views;
+use raycast_precompute::rig::orbit_views;
 use raycast_precompute::{
     BruteForce, PrecomputeSettings, Tracer, Traversal, precompute_with_tracer,
     precompute_with_traversal,
@@ -35,7 +35,7 @@ fn main() {
         let builds: Vec<f64> =
             (0..5).map(|_| Tracer::new(&mesh).build_time().as_secs_f64()).collect();
         let tracer = Tracer::new(&mesh);
-        let views = orbit_views(4, 42, 512, 2.6, 45.0, 11);
+        let views = orbit_views(4, 42, (512, 512), 2.6, 45.0, 11).unwrap();
         let settings = PrecomputeSettings::default();
         let _warm = precompute_with_tracer(&tracer, &views[..1], &settings).unwrap();
         // A/B: the one-by-one reference (A) and the packets (B), alternated, best of 5 each.

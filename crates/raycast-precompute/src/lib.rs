@@ -18,7 +18,8 @@
 //! * [`shadows`]: the shadow-ray stage, in 8 x 8-tile packets per light or one ray at a time.
 //! * [`visibility`]: the (pixel, light) bitsets.
 //! * [`cache`]: the content-keyed, checksummed on-disk cache.
-//! * [`scenes`]: standard orbit views with light domes, for benchmarks and figures.
+//! * [`rig`]: camera directions on an orbit and light directions in a cone (the scene crate
+//!   builds the dataset's camera rig from them).
 //!
 //! Conventions: directions are unit world-space vectors; light directions point from the
 //! surface towards the light; view directions from the surface towards the camera.
@@ -39,7 +40,6 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-mod binio;
 pub mod brute_force;
 pub mod cache;
 pub mod camera;
@@ -49,7 +49,7 @@ pub mod packet;
 pub mod packet_closest;
 mod packet_kernels;
 pub mod precompute;
-pub mod scenes;
+pub mod rig;
 pub mod shadows;
 pub mod tracer;
 pub mod visibility;

@@ -57,7 +57,7 @@ pub struct PrecomputeSettings {
 
 /// The precompute of one view, struct of arrays over its foreground pixels (those whose camera
 /// ray hit the mesh), in increasing pixel order.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct ViewPrecompute {
     /// Image width in pixels.
     pub width: u32,
@@ -94,7 +94,7 @@ impl ViewPrecompute {
 }
 
 /// Ray counts of a precompute.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub struct TraceStats {
     /// Camera rays traced.
     pub primary_rays: u64,
@@ -105,7 +105,7 @@ pub struct TraceStats {
 }
 
 /// The precompute of a scene.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct ScenePrecompute {
     /// One entry per input view, in order.
     pub views: Vec<ViewPrecompute>,
@@ -233,6 +233,57 @@ struct PixelHit {
     shadow_origin: Vec3,
 }
 
+/// The camera rays of the candidate pixels that hit the mesh, in pixel order, each shaded by
+/// `shade(pixel, direction, hit)`: one ray at a time, or rows of 8 x 8-tile packets.
+fn trace_primary(
+    tracer: &Tracer,
+    cam: &Camera,
+    candidates: &[u32],
+    traversal: Traversal,
+    shade: &(impl Fn(u32, Vec3, Hit) -> PixelHit + Sync),
+) -> Vec<PixelHit> {
+    match traversal {
+        Traversal::OneByOne => candidates
+            .par_iter()
+            .filter_map(|&pixel| {
+                let (origin, dir) = cam.pixel_ray(pixel as usize);
+                let hit = tracer.closest_hit(origin, dir, f32::INFINITY)?;
+                Some(shade(pixel, dir, hit))
+            })
+            .collect(),
+        Traversal::Packets => {
+            // Rows of 8 x 8 tiles in parallel, each tile's camera rays traced as packets.
+            let rows: Vec<Vec<PixelHit>> = tile_rows(candidates, cam.width, TILE)
+                .par_iter()
+                .map(|row| {
+                    let mut out = Vec::new();
+                    let (mut origins, mut dirs, mut found) = (Vec::new(), Vec::new(), Vec::new());
+                    for tile in row {
+                        origins.clear();
+                        dirs.clear();
+                        for &pixel in tile {
+                            let (o, d) = cam.pixel_ray(pixel as usize);
+                            origins.push(o);
+                            dirs.push(d);
+                        }
+                        found.clear();
+                        found.resize(tile.len(), None);
+                        tracer.closest_hits(&origins, &dirs, &mut found);
+                        for ((&pixel, &dir), hit) in tile.iter().zip(&dirs).zip(&found) {
+                            if let Some(hit) = hit {
+                                out.push(shade(pixel, dir, *hit));
+                            }
+                        }
+                    }
+                    out.sort_unstable_by_key(|h| h.pixel);
+                    out
+                })
+                .collect();
+            rows.into_iter().flatten().collect()
+        }
+    }
+}
+
 fn trace_view(
     tracer: &Tracer,
     vertex_normals: &[Vec3],
@@ -265,46 +316,7 @@ fn trace_view(
             shadow_origin: position + bias * facing,
         }
     };
-    let hits: Vec<PixelHit> = match traversal {
-        Traversal::OneByOne => candidates
-            .par_iter()
-            .filter_map(|&pixel| {
-                let (origin, dir) = cam.pixel_ray(pixel as usize);
-                let hit = tracer.closest_hit(origin, dir, f32::INFINITY)?;
-                Some(shade(pixel, dir, hit))
-            })
-            .collect(),
-        Traversal::Packets => {
-            // Rows of 8 x 8 tiles in parallel, each tile's camera rays traced as packets.
-            let rows: Vec<Vec<PixelHit>> = tile_rows(&candidates, cam.width, TILE)
-                .par_iter()
-                .map(|row| {
-                    let mut out = Vec::new();
-                    let (mut origins, mut dirs, mut found) = (Vec::new(), Vec::new(), Vec::new());
-                    for tile in row {
-                        origins.clear();
-                        dirs.clear();
-                        for &pixel in tile {
-                            let (o, d) = cam.pixel_ray(pixel as usize);
-                            origins.push(o);
-                            dirs.push(d);
-                        }
-                        found.clear();
-                        found.resize(tile.len(), None);
-                        tracer.closest_hits(&origins, &dirs, &mut found);
-                        for ((&pixel, &dir), hit) in tile.iter().zip(&dirs).zip(&found) {
-                            if let Some(hit) = hit {
-                                out.push(shade(pixel, dir, *hit));
-                            }
-                        }
-                    }
-                    out.sort_unstable_by_key(|h| h.pixel);
-                    out
-                })
-                .collect();
-            rows.into_iter().flatten().collect()
-        }
-    };
+    let hits = trace_primary(tracer, cam, &candidates, traversal, &shade);
 
     let origins: Vec<Vec3> = hits.iter().map(|h| h.shadow_origin).collect();
     let normals: Vec<Vec3> = hits.iter().map(|h| h.normal).collect();

@@ -15,7 +15,7 @@ pub enum LightState {
 }
 
 /// Visibility bits of one view, see the module documentation.
-#[derive(Debug, Clone, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Visibility {
     pub(crate) pixels: usize,
     pub(crate) lights: usize,

@@ -7,7 +7,7 @@ mod common;
 
 use common::Rng;
 use mesh_encoding::glam::Vec3;
-use raycast_precompute::scenes::orbit_views;
+use raycast_precompute::rig::orbit_views;
 use raycast_precompute::{
     PACKET_SIZE, PrecomputeSettings, Tracer, Traversal, precompute_with_traversal,
 };
@@ -17,7 +17,7 @@ fn packets_match_one_by_one_on_real_meshes() {
     for (name, size) in [("stanford-bunny.obj", 160), ("spot.obj", 128)] {
         let Some(mesh) = common::shared_mesh(name) else { return };
         let tracer = Tracer::new(&mesh);
-        let views = orbit_views(3, 42, size, 2.6, 45.0, 5);
+        let views = orbit_views(3, 42, (size, size), 2.6, 45.0, 5).unwrap();
         let settings = PrecomputeSettings::default();
         let simple =
             precompute_with_traversal(&tracer, &views, &settings, Traversal::OneByOne).unwrap();

@@ -104,7 +104,7 @@ fn cache_miss_hit_corruption_and_keys() {
             b[mid] ^= 0x10;
             b
         }),
-        ("length", good[..good.len() - 100].to_vec()),
+        ("truncated", good[..good.len() - 100].to_vec()),
         ("magic", {
             let mut b = good.clone();
             b[0] = b'X';

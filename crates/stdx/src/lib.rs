@@ -3,12 +3,16 @@
 //! - [`fs`]: atomic writes of a file or a whole directory (a reader never sees a half-written one);
 //! - [`rng`]: SplitMix64, the seeded generator behind every reproducible stream that is not a
 //!   `rand` one (orbit cameras, sensor noise, light splits, Lanczos start blocks, Monte Carlo);
-//! - [`progress`]: the progress-bar styles of every long step.
+//! - [`progress`]: the progress-bar styles of every long step;
+//! - [`cache_file`]: the versioned, checksummed container of every on-disk cache (serde values in
+//!   postcard).
 //!
-//! It sits at the bottom of the layering and depends on no crate of ours. `fs` and `progress`
-//! are features (off by default), so a crate that needs only the generator (brdf-analytic,
+//! It sits at the bottom of the layering and depends on no crate of ours. `fs`, `progress` and
+//! `cache` are features (off by default), so a crate that needs only the generator (brdf-analytic,
 //! usable alone by a renderer) pulls in nothing.
 
+#[cfg(feature = "cache")]
+pub mod cache_file;
 #[cfg(feature = "fs")]
 pub mod fs;
 #[cfg(feature = "progress")]

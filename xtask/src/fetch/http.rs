@@ -79,6 +79,7 @@ fn check_scheme(url: &str) -> Result<()> {
     Ok(())
 }
 
+/// One download attempt of `url` into the part file `part`, resuming from its length.
 fn attempt_once(
     agent: &ureq::Agent,
     url: &str,
@@ -86,14 +87,50 @@ fn attempt_once(
     expected_size: Option<u64>,
     label: &str,
 ) -> Result<Fetched, Fault> {
-    let disk = |what: &str| {
-        let msg = format!("{what} {}", part.display());
-        move |e: std::io::Error| Fault::Fatal(anyhow!(e).context(msg))
+    let (offset, mut hasher) = resume_point(part, expected_size, label)?;
+    let complete = |hasher: Sha256| Fetched {
+        sha256: hex(&hasher.finalize()),
+        len: offset,
+        resumed_from: offset,
     };
+    if offset > 0 && expected_size == Some(offset) {
+        return Ok(complete(hasher));
+    }
+    let Some(response) = send(agent, url, offset, part)? else {
+        return Ok(complete(hasher));
+    };
+    let (start, total) = body_range(&response, url, offset, part)?;
+    if start == 0 && offset > 0 {
+        eprintln!("    {url}: the server ignored the Range request; downloading it whole");
+        hasher = Sha256::new();
+    }
+    let len =
+        stream_to_part(response, (url, part), start, total.or(expected_size), &mut hasher, label)?;
+    if let Some(t) = total
+        && t != len
+    {
+        return Err(Fault::Retry(anyhow!("GET {url}: got {len} bytes of {t}")));
+    }
+    Ok(Fetched { sha256: hex(&hasher.finalize()), len, resumed_from: start })
+}
+
+/// An error on the part file: fatal (disk trouble is not cured by trying again).
+fn disk_fault(what: &str, part: &Path) -> impl Fn(std::io::Error) -> Fault {
+    let msg = format!("{what} {}", part.display());
+    move |e: std::io::Error| Fault::Fatal(anyhow!(e).context(msg.clone()))
+}
+
+/// Where the attempt starts: the part file's length (0 when there is none, or when it is
+/// longer than the expected size) and the hash of the bytes already there.
+fn resume_point(
+    part: &Path,
+    expected_size: Option<u64>,
+    label: &str,
+) -> Result<(u64, Sha256), Fault> {
     let mut offset = match std::fs::metadata(part) {
         Ok(m) => m.len(),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => 0,
-        Err(e) => return Err(disk("reading")(e)),
+        Err(e) => return Err(disk_fault("reading", part)(e)),
     };
     if expected_size.is_some_and(|s| offset > s) {
         truncate(part).map_err(Fault::Fatal)?;
@@ -103,84 +140,99 @@ fn attempt_once(
     if offset > 0 {
         hash_into(&mut hasher, part, Some(offset), &format!("{label} (partial)"))
             .map_err(Fault::Fatal)?;
-        if expected_size == Some(offset) {
-            return Ok(Fetched {
-                sha256: hex(&hasher.finalize()),
-                len: offset,
-                resumed_from: offset,
-            });
-        }
     }
+    Ok((offset, hasher))
+}
+
+/// The GET request for the bytes from `offset` on: the response, or `None` when the server
+/// says nothing is left past a complete part. Server errors and broken connections are
+/// retried, other failures are fatal.
+fn send(
+    agent: &ureq::Agent,
+    url: &str,
+    offset: u64,
+    part: &Path,
+) -> Result<Option<ureq::Response>, Fault> {
     // Bytes as stored: a compressed transfer would make byte offsets (resume) meaningless.
     let mut request = agent.get(url).set("Accept-Encoding", "identity");
     if offset > 0 {
         request = request.set("Range", &format!("bytes={offset}-"));
     }
-    let response = match request.call() {
-        Ok(r) => r,
+    match request.call() {
+        Ok(r) => Ok(Some(r)),
         Err(ureq::Error::Status(416, r)) if offset > 0 => {
             // Nothing left past `offset`: the part is complete if the server's total says so.
             if content_range(r.header("Content-Range")).is_some_and(|(_, t)| t == Some(offset)) {
-                return Ok(Fetched {
-                    sha256: hex(&hasher.finalize()),
-                    len: offset,
-                    resumed_from: offset,
-                });
+                return Ok(None);
             }
             truncate(part).map_err(Fault::Fatal)?;
-            return Err(Fault::Retry(anyhow!(
+            Err(Fault::Retry(anyhow!(
                 "GET {url}: HTTP 416 for a part of {offset} bytes; starting again from 0"
-            )));
+            )))
         }
         Err(ureq::Error::Status(code, r)) => {
             let e = anyhow!("GET {url}: HTTP {code} {}", r.status_text());
-            return Err(if code >= 500 || code == 408 || code == 429 {
+            Err(if code >= 500 || code == 408 || code == 429 {
                 Fault::Retry(e)
             } else {
                 Fault::Fatal(e)
-            });
+            })
         }
         Err(ureq::Error::Transport(t)) => {
             // ureq's message starts with the URL already.
             let msg = t.to_string();
             let msg = msg.strip_prefix(&format!("{url}: ")).unwrap_or(&msg).to_string();
             let e = anyhow!("GET {url}: {msg}");
-            return Err(if t.kind() == ureq::ErrorKind::Io {
-                Fault::Retry(e)
-            } else {
-                Fault::Fatal(e)
-            });
+            Err(if t.kind() == ureq::ErrorKind::Io { Fault::Retry(e) } else { Fault::Fatal(e) })
         }
-    };
+    }
+}
+
+/// The first byte the response carries and the file's total size, when known. A partial
+/// answer for another range empties the part file and is retried.
+fn body_range(
+    response: &ureq::Response,
+    url: &str,
+    offset: u64,
+    part: &Path,
+) -> Result<(u64, Option<u64>), Fault> {
     let length = response.header("Content-Length").and_then(|v| v.trim().parse::<u64>().ok());
-    let (start, total) = if response.status() == 206 {
-        match content_range(response.header("Content-Range")) {
-            Some((s, total)) if s == offset => (offset, total.or(length.map(|l| l + offset))),
-            _ => {
-                truncate(part).map_err(Fault::Fatal)?;
-                return Err(Fault::Retry(anyhow!(
-                    "GET {url}: the server answered bytes={offset}- with a different range; \
-                     starting again from 0"
-                )));
-            }
+    if response.status() != 206 {
+        return Ok((0, length));
+    }
+    match content_range(response.header("Content-Range")) {
+        Some((s, total)) if s == offset => Ok((offset, total.or(length.map(|l| l + offset)))),
+        _ => {
+            truncate(part).map_err(Fault::Fatal)?;
+            Err(Fault::Retry(anyhow!(
+                "GET {url}: the server answered bytes={offset}- with a different range; \
+                 starting again from 0"
+            )))
         }
-    } else {
-        if offset > 0 {
-            eprintln!("    {url}: the server ignored the Range request; downloading it whole");
-            hasher = Sha256::new();
-        }
-        (0, length)
-    };
+    }
+}
+
+/// Streams the response body into the part file from byte `start` on, hashing it and showing
+/// progress against `total`; returns the part's length. A broken transfer keeps what arrived
+/// (flushed) and is retried.
+fn stream_to_part(
+    response: ureq::Response,
+    (url, part): (&str, &Path),
+    start: u64,
+    total: Option<u64>,
+    hasher: &mut Sha256,
+    label: &str,
+) -> Result<u64, Fault> {
     let mut file = OpenOptions::new()
         .create(true)
         .write(true)
         .truncate(false)
         .open(part)
-        .map_err(disk("opening"))?;
-    file.set_len(start).map_err(disk("truncating"))?;
-    file.seek(SeekFrom::Start(start)).map_err(disk("seeking in"))?;
+        .map_err(disk_fault("opening", part))?;
+    file.set_len(start).map_err(disk_fault("truncating", part))?;
+    file.seek(SeekFrom::Start(start)).map_err(disk_fault("seeking in", part))?;
     let mut writer = std::io::BufWriter::with_capacity(1 << 20, file);
-    let pb = stdx::progress::bytes(label, total.or(expected_size));
+    let pb = stdx::progress::bytes(label, total);
     pb.set_position(start);
     let mut reader = response.into_reader();
     let mut buf = vec![0u8; 1 << 16];
@@ -192,26 +244,21 @@ fn attempt_once(
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
             Err(e) => {
                 pb.finish_and_clear();
-                writer.flush().map_err(disk("writing"))?;
+                writer.flush().map_err(disk_fault("writing", part))?;
                 return Err(Fault::Retry(anyhow!(
                     "GET {url}: the transfer broke off after {len} bytes ({e})"
                 )));
             }
         };
-        writer.write_all(&buf[..n]).map_err(disk("writing"))?;
+        writer.write_all(&buf[..n]).map_err(disk_fault("writing", part))?;
         hasher.update(&buf[..n]);
         len += n as u64;
         pb.inc(n as u64);
     }
     pb.finish_and_clear();
-    let file = writer.into_inner().map_err(|e| disk("writing")(e.into_error()))?;
-    file.sync_all().map_err(disk("syncing"))?;
-    if let Some(t) = total
-        && t != len
-    {
-        return Err(Fault::Retry(anyhow!("GET {url}: got {len} bytes of {t}")));
-    }
-    Ok(Fetched { sha256: hex(&hasher.finalize()), len, resumed_from: start })
+    let file = writer.into_inner().map_err(|e| disk_fault("writing", part)(e.into_error()))?;
+    file.sync_all().map_err(disk_fault("syncing", part))?;
+    Ok(len)
 }
 
 /// Empties the part file (the next attempt starts from byte 0).

@@ -224,15 +224,36 @@ fn download(
             String::new()
         }
     );
+    check_download(ctx, e, lock, (url, &part, path), expected, &got)?;
+    std::fs::rename(&part, path)
+        .with_context(|| format!("renaming {} to {}", part.display(), path.display()))?;
+    Ok(got.sha256)
+}
+
+/// Checks a finished download against the manifest's size and the expected sha256 (or its
+/// published prefix, or the user's acceptance of an unverified file); a failed check discards
+/// the part file.
+fn check_download(
+    ctx: &Ctx,
+    e: &Entry,
+    lock: &mut Lock,
+    (url, part, path): (&str, &Path, &Path),
+    expected: &Expected,
+    got: &http::Fetched,
+) -> Result<()> {
+    let want = match expected {
+        Expected::Manifest(s) | Expected::Lock(s) => Some(s.as_str()),
+        Expected::Unknown => None,
+    };
     if let Some(size) = e.size
         && size != got.len
     {
-        discard(&part);
+        discard(part);
         bail!("{url}: got {} bytes, the manifest says {size}; the download was discarded", got.len);
     }
     match (want, expected) {
         (Some(w), _) if w != got.sha256 => {
-            discard(&part);
+            discard(part);
             let from = if matches!(expected, Expected::Lock(_)) {
                 "the local lock"
             } else {
@@ -251,19 +272,17 @@ fn download(
             if let Some(p) = &e.sha256_prefix
                 && !got.sha256.starts_with(p.as_str())
             {
-                discard(&part);
+                discard(part);
                 bail!(
                     "sha256 of {url} is {}, which does not start with the published prefix {p}; \
                      the download was discarded",
                     got.sha256
                 );
             }
-            accept_unverified(ctx, e, lock, &part, &got.sha256, got.len, "downloaded")?;
+            accept_unverified(ctx, e, lock, part, &got.sha256, got.len, "downloaded")?;
         }
     }
-    std::fs::rename(&part, path)
-        .with_context(|| format!("renaming {} to {}", part.display(), path.display()))?;
-    Ok(got.sha256)
+    Ok(())
 }
 
 /// Accepts a file without a known checksum when the user said so, recording it in the lock.

@@ -19,16 +19,9 @@ use brdf_analytic::{Brdf, Rgb};
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::sync::Arc;
 
-/// How a MERL table is sampled between its bins.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Lookup {
-    /// The reference reader's rule: the bin containing the angles, no interpolation.
-    #[default]
-    NearestLower,
-    /// Trilinear interpolation between bin lower edges (periodic in phi_d).
-    Trilinear,
-}
+/// How a MERL table is sampled between its bins: part of a scene's settings, so defined by the
+/// scene format.
+pub use scene::Lookup;
 
 /// Continuous index coordinate of theta_h: sqrt(theta_h / (pi/2)) 90.
 #[inline]

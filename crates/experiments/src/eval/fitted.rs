@@ -8,8 +8,8 @@ use crate::train::load_weights;
 use crate::{Error, Result};
 use brdf_neural::BrdfModel;
 use burn::tensor::Device;
-use dataset_merl::scene::Split;
-use dataset_merl::{SampleSet, SceneDataset};
+use scene::Split;
+use scene::{SampleSet, SceneDataset};
 use std::path::{Path, PathBuf};
 
 /// A finished run with its model loaded and its scene opened.
@@ -43,6 +43,13 @@ impl FittedRun {
         let dataset = SceneDataset::open(&scene_dir)?;
         let cache = run.cache(&config, cache);
         Ok(Self { config, device, model, dataset, cache })
+    }
+
+    /// The run that was just trained in this process, from what training hands over (no
+    /// weights or scene read back from disk).
+    pub fn from_trained(config: RunConfig, trained: crate::train::Trained, cache: PathBuf) -> Self {
+        let device = brdf_neural::device::cpu();
+        Self { config, device, model: trained.model, dataset: trained.scene, cache }
     }
 
     /// Another weight file of the same configuration (a snapshot) on the run's device.

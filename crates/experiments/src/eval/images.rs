@@ -33,14 +33,14 @@
 use super::predict::Prediction;
 use crate::data::TrainingData;
 use crate::{Error, Result};
-use dataset_merl::scene::Split;
-use dataset_merl::scene::images::{write_exr_rgb, write_png_srgb};
-use dataset_merl::scene::render::shade;
-use dataset_merl::{SampleSet, SceneDataset};
 use indicatif::ProgressBar;
 use metrics::Image;
 use metrics::lpips::Lpips;
 use rayon::prelude::*;
+use scene::Split;
+use scene::images::{exr_rgb_bytes, png_srgb_bytes};
+use scene::shading::shade;
+use scene::{SampleSet, SceneDataset};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -94,6 +94,16 @@ pub struct ImageScores {
     pub ceiling: Option<ImageMetrics>,
     /// Test images scored.
     pub images: usize,
+}
+
+/// Writes a linear RGB image as an EXR file atomically.
+fn write_exr_rgb(path: &Path, width: usize, height: usize, rgb: &[[f32; 3]]) -> Result<()> {
+    Ok(stdx::fs::write_atomic(path, &exr_rgb_bytes(path, width, height, rgb)?)?)
+}
+
+/// Writes a linear RGB image as an 8-bit sRGB PNG atomically.
+fn write_png_srgb(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<()> {
+    Ok(stdx::fs::write_atomic(path, &png_srgb_bytes(path, width, height, rgb)?)?)
 }
 
 /// Writes an 8-bit RGB PNG atomically.
@@ -169,7 +179,7 @@ pub struct RenderOptions<'a> {
 /// The clip level renders get: the saturation of semi-synthetic scenes, none for captures
 /// (whose observations are raw values divided by a per-light intensity).
 pub fn clip_level(dataset: &SceneDataset) -> Option<f32> {
-    use dataset_merl::scene::MaterialSpec;
+    use scene::MaterialSpec;
     let c = &dataset.manifest.config;
     (!matches!(c.material, MaterialSpec::Captured { .. })).then_some(c.settings.saturation)
 }

@@ -29,8 +29,8 @@ pub use settings::{EnergyEstimator, EvalConfig, EvalSettings};
 use crate::Result;
 use crate::data::TrainingData;
 use crate::run_dir::{RunDir, RunMetrics, Snapshot};
-use dataset_merl::SampleSet;
 use metrics::rmse::{CubeRootRmse, RmseConfig};
+use scene::SampleSet;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::time::Instant;
@@ -141,7 +141,7 @@ pub fn cube_root_rmse(
 struct CeilingCache(std::path::PathBuf);
 
 impl CeilingCache {
-    fn new(cache: &Path, scene: &dataset_merl::SceneDataset, lpips: bool) -> Self {
+    fn new(cache: &Path, scene: &scene::SceneDataset, lpips: bool) -> Self {
         let key =
             format!("{}\n{lpips}\n{}", scene.manifest.checksum, crate::sweep::plan::CODE_VERSION);
         let hash = xxhash_rust::xxh3::xxh3_64(key.as_bytes());
@@ -187,6 +187,17 @@ pub fn eval(
 ) -> Result<TestMetrics> {
     let start = Instant::now();
     let fitted = FittedRun::open(run, scene, cache)?;
+    eval_fitted(&fitted, run, progress, start)
+}
+
+/// Evaluates an opened (or just trained) run whose directory is `run`; `start` is when the
+/// evaluation began (its wall time is recorded).
+pub fn eval_fitted(
+    fitted: &FittedRun,
+    run: &Path,
+    progress: bool,
+    start: Instant,
+) -> Result<TestMetrics> {
     let (config, device, model, dataset) =
         (&fitted.config, &fitted.device, &fitted.model, &fitted.dataset);
     let settings = config.eval.resolve(config.train.profile);
@@ -220,7 +231,7 @@ pub fn eval(
     let energy = analyses::energy(&brdf, &settings, config.seed, progress)?;
     let path = RunDir::new(run).metrics();
     let mut all = RunMetrics::read(&path)?;
-    let curve = snapshot_curve(&fitted, run, &all.snapshots, (&samples, &data))?;
+    let curve = snapshot_curve(fitted, run, &all.snapshots, (&samples, &data))?;
     let test = TestMetrics {
         psnr: scores.model.psnr,
         dssim: scores.model.dssim,

@@ -23,17 +23,14 @@ use super::plan::{self, Purpose};
 use crate::config::RunConfig;
 use crate::eval::ImageMetrics;
 use crate::plateau::StopReason;
-use crate::report::{
-    self, Dataset, MetricKind, ModelRender, QualitativeRow, RgbImage, RunOptions, RunRecord, Table,
-};
 use crate::run_dir::{RunDir, RunMetrics, SweepLayout};
 use crate::{Error, Result};
-use dataset_merl::scene::render::flag;
 use metrics::aggregate::Score;
+use report::{
+    self, Dataset, MetricKind, ModelRender, QualitativeRow, RgbImage, RunOptions, RunRecord, Table,
+};
+use scene::flag;
 use std::path::{Path, PathBuf};
-
-/// The pixels the masked image metrics score: on the object (lit, shadowed or facing away).
-const FOREGROUND: u8 = flag::LIT | flag::SHADOWED | flag::BACK_FACING;
 
 /// One collected run.
 #[derive(Clone, Debug)]
@@ -192,7 +189,7 @@ pub fn convergence_note(runs: &[&CollectedRun]) -> Option<String> {
 /// The data set of a scene directory, from its manifest: captured scenes name their benchmark,
 /// everything else is MERL-derived.
 fn scene_dataset(scene: Option<&Path>) -> Dataset {
-    use dataset_merl::scene::{Manifest, MaterialSpec, manifest::MANIFEST_FILE};
+    use scene::{MANIFEST_FILE, Manifest, MaterialSpec};
     match scene.and_then(|s| Manifest::read(&s.join(MANIFEST_FILE)).ok()) {
         Some(m) => match m.config.material {
             MaterialSpec::Captured { benchmark, .. } => Dataset::from_label(&benchmark),
@@ -358,7 +355,7 @@ fn ceiling_psnr(ceiling: &[RunRecord], curves: &[RunRecord]) -> Option<f64> {
 }
 
 fn load_exr(path: &Path) -> Result<metrics::Image> {
-    let (w, h, px) = dataset_merl::scene::images::read_exr_rgb(path)?;
+    let (w, h, px) = scene::images::read_exr_rgb(path)?;
     Ok(metrics::Image::new(w, h, px.into_iter().flatten().collect())?)
 }
 
@@ -366,7 +363,7 @@ fn load_png(path: &Path) -> Result<RgbImage> {
     let img = image::open(path).map_err(|e| Error::format(path, e.to_string()))?.to_rgb8();
     let (w, h) = img.dimensions();
     let px: Vec<[u8; 3]> = img.pixels().map(|p| p.0).collect();
-    RgbImage::new(w, h, px)
+    Ok(RgbImage::new(w, h, px)?)
 }
 
 /// The qualitative grid and the split figure of every object (first test image).
@@ -388,48 +385,19 @@ fn figures(runs: &[CollectedRun], out: &Path, summary: &mut CollectSummary) -> R
         let Some(scene) = first.config.scene.clone() else { continue };
         let Some(stem) = first_render(&first.dir) else { continue };
         let Some((v, l)) = parse_stem(&stem) else { continue };
-        let gt_path =
-            scene.join(format!("images/{}.exr", dataset_merl::scene::generate::sample_stem(v, l)));
-        let Ok(gt) = load_exr(&gt_path) else { continue };
-        let flags = dataset_merl::scene::images::read_png_gray(
-            &scene.join(format!("flags/{}.png", dataset_merl::scene::generate::sample_stem(v, l))),
-        );
+        let stem_vl = scene::sample_stem(v, l);
+        let Ok(gt) = load_exr(&scene.join(format!("images/{stem_vl}.exr"))) else { continue };
+        let flags = scene::images::read_png_gray(&scene.join(format!("flags/{stem_vl}.png")));
         let mask: Option<Vec<bool>> =
-            flags.ok().map(|(_, _, f)| f.iter().map(|&b| b & FOREGROUND != 0).collect());
+            flags.ok().map(|(_, _, f)| f.iter().map(|&b| b & flag::FOREGROUND != 0).collect());
         let mut renders = Vec::new();
         let mut split_rows = Vec::new();
         for r in &mine {
-            let run = RunDir::new(&r.dir);
-            let Ok(img) = load_exr(&run.renders().join(format!("{stem}.exr"))) else { continue };
-            let psnr = metrics::psnr_linear(&img, &gt, mask.as_deref())
-                .map(Score::Value)
-                .unwrap_or_else(|e| Score::Unavailable(e.to_string()));
-            let flip = load_png(&run.flip().join(format!("{stem}.png"))).ok().map(|map| {
-                let mean = metrics::hdr_flip(&img, &gt, mask.as_deref())
-                    .map(Score::Value)
-                    .unwrap_or_else(|e| Score::Unavailable(e.to_string()));
-                (map, mean)
-            });
-            let name = r.record.model.paper_name().to_string();
-            renders.push(ModelRender {
-                model: name.clone(),
-                render: RgbImage::from_linear(&img),
-                psnr_db: psnr,
-                flip,
-            });
-            if r.record.model.is_additive() {
-                let mut cells = vec![("render".to_string(), RgbImage::from_linear(&img))];
-                for (label, file) in [
-                    ("diffuse", run.renders().join(format!("{stem}_diffuse.png"))),
-                    ("specular", run.renders().join(format!("{stem}_specular.png"))),
-                    ("albedo", run.albedo().join(format!("view{v:03}.png"))),
-                ] {
-                    if let Ok(p) = load_png(&file) {
-                        cells.push((label.to_string(), p));
-                    }
-                }
-                split_rows.push((name, cells));
-            }
+            let Some((render, split)) = run_figure_cells(r, &stem, v, &gt, mask.as_deref()) else {
+                continue;
+            };
+            renders.push(render);
+            split_rows.extend(split);
         }
         let row = QualitativeRow {
             label: format!("view {v}, light {l}"),
@@ -457,6 +425,49 @@ fn figures(runs: &[CollectedRun], out: &Path, summary: &mut CollectSummary) -> R
         }
     }
     Ok(())
+}
+
+/// A row of the additive split figure: the model's name and its (caption, image) cells.
+type SplitRow = (String, Vec<(String, RgbImage)>);
+
+/// A run's cells of the figures for test image `stem` of view `v`: its render with PSNR and
+/// FLIP against the observation `gt` (scored on `mask`), and for an additive model its row of
+/// the split figure (render, diffuse, specular, albedo). `None` when the run has no such render.
+fn run_figure_cells(
+    r: &CollectedRun,
+    stem: &str,
+    v: usize,
+    gt: &metrics::Image,
+    mask: Option<&[bool]>,
+) -> Option<(ModelRender, Option<SplitRow>)> {
+    let run = RunDir::new(&r.dir);
+    let img = load_exr(&run.renders().join(format!("{stem}.exr"))).ok()?;
+    let psnr = metrics::psnr_linear(&img, gt, mask)
+        .map(Score::Value)
+        .unwrap_or_else(|e| Score::Unavailable(e.to_string()));
+    let flip = load_png(&run.flip().join(format!("{stem}.png"))).ok().map(|map| {
+        let mean = metrics::hdr_flip(&img, gt, mask)
+            .map(Score::Value)
+            .unwrap_or_else(|e| Score::Unavailable(e.to_string()));
+        (map, mean)
+    });
+    let name = r.record.model.paper_name().to_string();
+    let split = r.record.model.is_additive().then(|| {
+        let mut cells = vec![("render".to_string(), RgbImage::from_linear(&img))];
+        for (label, file) in [
+            ("diffuse", run.renders().join(format!("{stem}_diffuse.png"))),
+            ("specular", run.renders().join(format!("{stem}_specular.png"))),
+            ("albedo", run.albedo().join(format!("view{v:03}.png"))),
+        ] {
+            if let Ok(p) = load_png(&file) {
+                cells.push((label.to_string(), p));
+            }
+        }
+        (name.clone(), cells)
+    });
+    let render =
+        ModelRender { model: name, render: RgbImage::from_linear(&img), psnr_db: psnr, flip };
+    Some((render, split))
 }
 
 /// The stem (`view007_light003`) of the first EXR render of a run.

@@ -10,10 +10,13 @@
 use super::plan::{self, Purpose, RunInfo, RunSpec, SceneSpec};
 use super::profile::{SweepProfile, resolve_mesh};
 use crate::config::SpatialKind;
+use crate::eval::fitted::FittedRun;
 use crate::run_dir::{RunDir, SweepLayout};
-use crate::{Error, FitOptions, FitOutcome, Result, fit};
-use dataset_merl::scene::{MaterialSpec, SceneConfig, SceneSettings};
-use dataset_merl::{SceneDataset, generate_scene};
+use crate::train::fit_and_keep;
+use crate::{Error, FitOptions, FitOutcome, Result};
+use dataset_merl::generate_scene;
+use scene::SceneDataset;
+use scene::{MaterialSpec, SceneConfig, SceneSettings};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
@@ -65,7 +68,8 @@ pub fn is_done(run: &Path) -> bool {
     RunDir::new(run).is_evaluated()
 }
 
-/// Fits (resuming) and evaluates one prepared run directory.
+/// Fits (resuming) and evaluates one prepared run directory. The configuration is read once;
+/// a run trained here is evaluated with the model and scene training hands over.
 pub fn run_one(run: &Path, progress: bool) -> Result<()> {
     if is_done(run) {
         return Ok(());
@@ -73,14 +77,20 @@ pub fn run_one(run: &Path, progress: bool) -> Result<()> {
     let dir = RunDir::new(run);
     let config = dir.read_config()?;
     let cache = dir.cache(&config, None);
-    let options = FitOptions { progress, cache_dir: Some(cache.clone()), ..Default::default() };
-    match fit(&config, run, options)? {
-        FitOutcome::Stopped(step) => {
+    let options = FitOptions {
+        progress,
+        cache_dir: Some(cache.clone()),
+        config_from_run_dir: true,
+        ..Default::default()
+    };
+    let fitted = match fit_and_keep(&config, run, options)? {
+        (FitOutcome::Stopped(step), _) => {
             return Err(Error::format(run, format!("training stopped at step {step}")));
         }
-        FitOutcome::Finished { .. } | FitOutcome::AlreadyFinished(_) => {}
-    }
-    crate::eval::eval(run, None, Some(&cache), progress)?;
+        (_, Some(trained)) => FittedRun::from_trained(config, trained, cache),
+        (_, None) => FittedRun::open(run, None, Some(&cache))?,
+    };
+    crate::eval::eval_fitted(&fitted, run, progress, Instant::now())?;
     Ok(())
 }
 
@@ -126,8 +136,8 @@ pub fn prepare_runs(
 ) -> Result<Vec<PathBuf>> {
     let mut checksums = Vec::new();
     for dir in scene_dirs {
-        let path = dir.join(dataset_merl::scene::manifest::MANIFEST_FILE);
-        checksums.push(dataset_merl::scene::Manifest::read(&path)?.checksum);
+        let path = dir.join(scene::MANIFEST_FILE);
+        checksums.push(scene::Manifest::read(&path)?.checksum);
     }
     let mut dirs = Vec::new();
     for spec in specs {

@@ -9,10 +9,10 @@
 
 use super::profile::{Ablation, SweepProfile, mesh_name};
 use crate::config::RunConfig;
-use crate::report::RunOptions;
 use crate::run_dir::RunDir;
 use crate::{Error, Result};
 use brdf_neural::{AngleParametrization, ModelKind, Reciprocity};
+use report::RunOptions;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

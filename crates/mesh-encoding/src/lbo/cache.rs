@@ -3,9 +3,9 @@
 //! * **Key**: xxh3-128 of a format version, the vertex positions and triangles (as f64 / u32
 //!   little-endian bytes), `k` and every [`EigenSettings`] field. Any change to the mesh or the
 //!   solve gives a new file name `lbo-<key as 32 hex digits>.bin`.
-//! * **File** (little-endian): magic `NBLBOEIG`, format version `u32`, key `u128`, `n u64`,
-//!   `k u64`, `k` eigenvalues `f64`, the `n x k` eigenvectors column by column `f64`, then the
-//!   xxh3-64 checksum `u64` of everything before it.
+//! * **File**: the workspace's cache container (`stdx::cache_file`: magic `NBLBOEIG`, format
+//!   version, key, then `n`, `k`, the `k` eigenvalues and the `n x k` eigenvectors column by
+//!   column in postcard, and the payload's xxh3-64 checksum).
 //! * Written to a temporary file in the same directory and renamed into place, so a reader
 //!   never sees a half-written file. A file with a wrong magic, version, key, size or checksum
 //!   is reported as [`CacheOutcome::Recomputed`] and overwritten.
@@ -13,7 +13,7 @@
 use std::path::{Path, PathBuf};
 
 use faer::Mat;
-use xxhash_rust::xxh3::{xxh3_64, xxh3_128};
+use xxhash_rust::xxh3::xxh3_128;
 
 use super::assembly::LboMatrices;
 use super::eigen::{EigenSettings, Eigenpairs, smallest_eigenpairs};
@@ -22,8 +22,21 @@ use crate::error::{Error, Result};
 const MAGIC: &[u8; 8] = b"NBLBOEIG";
 /// Bumped whenever the file layout or the meaning of the cached numbers changes.
 /// Version 2: the faster block Lanczos (block 16, adaptive Ritz checks; rounding-level changes).
-const FORMAT_VERSION: u32 = 2;
-const HEADER_LEN: usize = 8 + 4 + 16 + 8 + 8;
+/// Version 3: the payload is [`CachedPairs`] in the workspace's cache container (postcard).
+const FORMAT_VERSION: u32 = 3;
+
+/// The payload of a cache file.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct CachedPairs {
+    /// Vertex count.
+    n: u64,
+    /// Eigenpair count.
+    k: u64,
+    /// Eigenvalues.
+    values: Vec<f64>,
+    /// Eigenvectors, column-major (`n` values per column).
+    vectors: Vec<f64>,
+}
 
 /// What [`cached_eigenpairs`] did.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -114,56 +127,22 @@ pub fn cached_eigenpairs(
 /// Serialises pairs into the cache layout.
 fn encode(pairs: &Eigenpairs, key: u128) -> Vec<u8> {
     let (n, k) = (pairs.vertex_count(), pairs.len());
-    let mut out = Vec::with_capacity(HEADER_LEN + 8 * (k + n * k) + 8);
-    out.extend_from_slice(MAGIC);
-    out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
-    out.extend_from_slice(&key.to_le_bytes());
-    out.extend_from_slice(&(n as u64).to_le_bytes());
-    out.extend_from_slice(&(k as u64).to_le_bytes());
-    for v in &pairs.values {
-        out.extend_from_slice(&v.to_le_bytes());
-    }
-    for j in 0..k {
-        for x in pairs.vectors.col_as_slice(j) {
-            out.extend_from_slice(&x.to_le_bytes());
-        }
-    }
-    let checksum = xxh3_64(&out);
-    out.extend_from_slice(&checksum.to_le_bytes());
-    out
+    let vectors = (0..k).flat_map(|j| pairs.vectors.col_as_slice(j).iter().copied()).collect();
+    let payload = CachedPairs { n: n as u64, k: k as u64, values: pairs.values.clone(), vectors };
+    stdx::cache_file::encode(MAGIC, FORMAT_VERSION, key, &payload)
 }
 
 /// Parses and checks a cache file; the error says why it is unusable.
 fn decode(bytes: &[u8], key: u128, n: usize, k: usize) -> std::result::Result<Eigenpairs, String> {
-    let expected_len = HEADER_LEN + 8 * (k + n * k) + 8;
-    if bytes.len() < HEADER_LEN || &bytes[..8] != MAGIC {
-        return Err("not an LBO cache file (bad magic)".into());
+    let p: CachedPairs = stdx::cache_file::decode(bytes, MAGIC, FORMAT_VERSION, key)?;
+    if (p.n, p.k) != (n as u64, k as u64) {
+        return Err(format!("sizes {} x {}, expected {n} x {k}", p.n, p.k));
     }
-    let u64_at = |o: usize| u64::from_le_bytes(bytes[o..o + 8].try_into().expect("8 bytes"));
-    let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
-    if version != FORMAT_VERSION {
-        return Err(format!("format version {version}, expected {FORMAT_VERSION}"));
+    if p.values.len() != k || p.vectors.len() != n * k {
+        return Err("inconsistent array lengths".into());
     }
-    let file_key = u128::from_le_bytes(bytes[12..28].try_into().expect("16 bytes"));
-    if file_key != key {
-        return Err("content key mismatch".into());
-    }
-    let (file_n, file_k) = (u64_at(28), u64_at(36));
-    if file_n != n as u64 || file_k != k as u64 {
-        return Err(format!("sizes {file_n} x {file_k}, expected {n} x {k}"));
-    }
-    if bytes.len() != expected_len {
-        return Err(format!("length {} bytes, expected {expected_len} (truncated?)", bytes.len()));
-    }
-    let body = &bytes[..expected_len - 8];
-    if xxh3_64(body) != u64_at(expected_len - 8) {
-        return Err("checksum mismatch (corrupted)".into());
-    }
-    let f64_at = |o: usize| f64::from_le_bytes(bytes[o..o + 8].try_into().expect("8 bytes"));
-    let values: Vec<f64> = (0..k).map(|i| f64_at(HEADER_LEN + 8 * i)).collect();
-    let base = HEADER_LEN + 8 * k;
-    let vectors = Mat::<f64>::from_fn(n, k, |i, j| f64_at(base + 8 * (j * n + i)));
-    Ok(Eigenpairs { values, vectors })
+    let vectors = Mat::<f64>::from_fn(n, k, |i, j| p.vectors[j * n + i]);
+    Ok(Eigenpairs { values: p.values, vectors })
 }
 
 #[cfg(test)]
@@ -188,7 +167,7 @@ mod tests {
         assert!(decode(&bytes, 42, 5, 3).unwrap_err().contains("sizes"));
         assert!(decode(&bytes[..bytes.len() - 3], 42, 4, 3).unwrap_err().contains("truncated"));
         let mut flipped = bytes.clone();
-        flipped[HEADER_LEN + 17] ^= 0x10;
+        flipped[28 + 17] ^= 0x10;
         assert!(decode(&flipped, 42, 4, 3).unwrap_err().contains("checksum"));
         let mut magic = bytes.clone();
         magic[0] = b'X';

@@ -211,6 +211,36 @@ pub(crate) fn weyl_spacing(matrices: &LboMatrices) -> f64 {
 /// generalized eigenproblem of this size takes seconds).
 pub const DENSE_FALLBACK_VERTICES: usize = 8_000;
 
+/// Checks that `k` pairs of an `n`-vertex mesh can be computed with these settings.
+fn check_request(k: usize, n: usize, settings: &EigenSettings) -> Result<()> {
+    if k == 0 || k > n {
+        return Err(Error::lbo(format!("cannot compute {k} eigenpairs of a {n}-vertex mesh")));
+    }
+    let positive = |x: f64| x > 0.0;
+    if settings.block_size == 0
+        || !positive(settings.tolerance)
+        || !positive(-settings.shift_factor)
+    {
+        return Err(Error::lbo(format!("invalid eigen-solver settings {settings:?}")));
+    }
+    Ok(())
+}
+
+/// The dense solver's pairs with their report (the solve began at `start`).
+fn dense_solve(
+    matrices: &LboMatrices,
+    k: usize,
+    start: Instant,
+) -> Result<(Eigenpairs, SolveReport)> {
+    let pairs = dense_eigenpairs(matrices, k)?;
+    let report = SolveReport {
+        dense: true,
+        total_seconds: start.elapsed().as_secs_f64(),
+        ..Default::default()
+    };
+    Ok((pairs, report))
+}
+
 /// The `k` smallest eigenpairs of `L phi = lambda M phi` by shift-invert block Lanczos (see
 /// the module documentation), or by the dense solver for small problems.
 ///
@@ -224,16 +254,7 @@ pub fn smallest_eigenpairs(
 ) -> Result<(Eigenpairs, SolveReport)> {
     let start = Instant::now();
     let n = matrices.vertex_count();
-    if k == 0 || k > n {
-        return Err(Error::lbo(format!("cannot compute {k} eigenpairs of a {n}-vertex mesh")));
-    }
-    let positive = |x: f64| x > 0.0;
-    if settings.block_size == 0
-        || !positive(settings.tolerance)
-        || !positive(-settings.shift_factor)
-    {
-        return Err(Error::lbo(format!("invalid eigen-solver settings {settings:?}")));
-    }
+    check_request(k, n, settings)?;
     // A block much wider than k / 8 would leave too few Krylov steps (the polynomial degree).
     let b = settings.block_size.min((k / 8).max(8));
     let shift = settings.shift_factor * weyl_spacing(matrices);
@@ -242,13 +263,7 @@ pub fn smallest_eigenpairs(
     // Lanczos needs a basis of about 3 k vectors for k pairs (1,472 for 513 on the bunny); when
     // half the vertex count cannot hold that, the mesh is small and the dense solver is cheap.
     if k + 3 * b > n / 2 || max_basis < k + 2 * b || max_basis < 3 * k {
-        let pairs = dense_eigenpairs(matrices, k)?;
-        let report = SolveReport {
-            dense: true,
-            total_seconds: start.elapsed().as_secs_f64(),
-            ..Default::default()
-        };
-        return Ok((pairs, report));
+        return dense_solve(matrices, k, start);
     }
     if settings.slice_size > 0 && k > 2 * settings.slice_size {
         return super::slicing::sliced_eigenpairs(matrices, k, settings);
@@ -272,15 +287,7 @@ pub fn smallest_eigenpairs(
         let run = match block_lanczos(&llt, &sqrt_m, k, b, max_basis, settings, seed, par) {
             Ok(run) => run,
             // A small mesh whose basis cap was too tight: the dense solver still answers.
-            Err(_) if n <= DENSE_FALLBACK_VERTICES => {
-                let pairs = dense_eigenpairs(matrices, k)?;
-                let report = SolveReport {
-                    dense: true,
-                    total_seconds: start.elapsed().as_secs_f64(),
-                    ..Default::default()
-                };
-                return Ok((pairs, report));
-            }
+            Err(_) if n <= DENSE_FALLBACK_VERTICES => return dense_solve(matrices, k, start),
             Err(e) => return Err(e),
         };
         let pairs = finish(matrices, run.basis.as_ref(), &run.ritz, k, &d, shift, par);

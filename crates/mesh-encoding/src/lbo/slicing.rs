@@ -109,25 +109,67 @@ fn factor_ldlt(
 /// # Errors
 /// [`Error::Lbo`] when the factorisation fails (`mu` numerically an eigenvalue).
 pub(crate) fn count_below(matrices: &LboMatrices, mu: f64, par: Par) -> Result<usize> {
-    let mut a = matrices.stiffness.clone();
-    {
+    Ok(ShiftedPencil::new(matrices, par)?.factor(mu)?.below)
+}
+
+/// `L - mu M` for any shift `mu`, sharing one symbolic analysis: `a` keeps L's pattern (the
+/// diagonal is always present) and gets its values refilled per shift.
+struct ShiftedPencil<'a> {
+    a: SparseColMat<usize, f64>,
+    /// Where each column's diagonal entry sits in `a`'s values.
+    diag_pos: Vec<usize>,
+    symbolic: SymbolicCholesky<usize>,
+    /// L's values.
+    l_values: Vec<f64>,
+    mass: &'a [f64],
+    par: Par,
+}
+
+impl<'a> ShiftedPencil<'a> {
+    fn new(matrices: &'a LboMatrices, par: Par) -> Result<Self> {
         let l = matrices.stiffness.as_ref();
         let col_ptr = l.col_ptr();
-        let vals = a.val_mut();
-        for j in 0..matrices.vertex_count() {
-            let rows = l.row_idx_of_col_raw(j);
-            let p = rows.iter().position(|&i| i == j).ok_or_else(|| Error::lbo("no diagonal"))?;
-            vals[col_ptr[j] + p] -= mu * matrices.mass[j];
-        }
+        let diag_pos = (0..matrices.vertex_count())
+            .map(|j| {
+                let rows = l.row_idx_of_col_raw(j);
+                let p =
+                    rows.iter().position(|&i| i == j).ok_or_else(|| Error::lbo("no diagonal"))?;
+                Ok(col_ptr[j] + p)
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let a = matrices.stiffness.clone();
+        let symbolic = factorize_symbolic_cholesky(
+            a.symbolic(),
+            Side::Lower,
+            faer::sparse::linalg::cholesky::SymmetricOrdering::Amd,
+            Default::default(),
+        )
+        .map_err(|e| Error::lbo(format!("symbolic factorisation failed: {e:?}")))?;
+        let l_values = matrices.stiffness.val().to_vec();
+        Ok(Self { a, diag_pos, symbolic, l_values, mass: &matrices.mass, par })
     }
-    let symbolic = factorize_symbolic_cholesky(
-        a.symbolic(),
-        Side::Lower,
-        faer::sparse::linalg::cholesky::SymmetricOrdering::Amd,
-        Default::default(),
-    )
-    .map_err(|e| Error::lbo(format!("symbolic factorisation failed: {e:?}")))?;
-    Ok(factor_ldlt(&symbolic, &a, par)?.below)
+
+    /// The `LDL^T` factor of `L - mu M`.
+    fn factor(&mut self, mu: f64) -> Result<ShiftFactor> {
+        let vals = self.a.val_mut();
+        vals.copy_from_slice(&self.l_values);
+        for (j, &p) in self.diag_pos.iter().enumerate() {
+            vals[p] -= mu * self.mass[j];
+        }
+        factor_ldlt(&self.symbolic, &self.a, self.par)
+    }
+}
+
+/// The columns of every slice's vectors side by side.
+fn concat_columns(n: usize, blocks: &[Mat<f64>]) -> Mat<f64> {
+    let total = blocks.iter().map(Mat::ncols).sum();
+    let mut x = Mat::<f64>::zeros(n, total);
+    let mut col = 0;
+    for v in blocks {
+        x.as_mut().subcols_mut(col, v.ncols()).copy_from(v);
+        col += v.ncols();
+    }
+    x
 }
 
 /// The sliced solve (see the module documentation). Called by
@@ -145,63 +187,34 @@ pub(crate) fn sliced_eigenpairs(
     let q = settings.slice_size.max(8);
     let b = settings.block_size.min(q / 2).max(8);
 
-    // Shared symbolic analysis; `a` keeps L's pattern (the diagonal is always present).
-    let mut a = matrices.stiffness.clone();
-    let diag_pos: Vec<usize> = {
-        let l = matrices.stiffness.as_ref();
-        let col_ptr = l.col_ptr();
-        (0..n)
-            .map(|j| {
-                let rows = l.row_idx_of_col_raw(j);
-                col_ptr[j] + rows.iter().position(|&i| i == j).expect("diagonal entry")
-            })
-            .collect()
-    };
-    let symbolic = factorize_symbolic_cholesky(
-        a.symbolic(),
-        Side::Lower,
-        faer::sparse::linalg::cholesky::SymmetricOrdering::Amd,
-        Default::default(),
-    )
-    .map_err(|e| Error::lbo(format!("symbolic factorisation failed: {e:?}")))?;
-    let l_values: Vec<f64> = matrices.stiffness.val().to_vec();
-    let factor_at = |mu: f64, a: &mut SparseColMat<usize, f64>| -> Result<ShiftFactor> {
-        let vals = a.val_mut();
-        vals.copy_from_slice(&l_values);
-        for (j, &p) in diag_pos.iter().enumerate() {
-            vals[p] -= mu * matrices.mass[j];
-        }
-        factor_ldlt(&symbolic, a, par)
-    };
-
+    let mut pencil = ShiftedPencil::new(matrices, par)?;
     let sqrt_m: Vec<f64> = matrices.mass.iter().map(|m| m.sqrt()).collect();
     let mut times = PhaseTimes::default();
     // Slightly irrational step so shifts do not land on the integer spectrum of a unit sphere.
     let mut step = q as f64 * weyl * 1.0137;
     let mut lower = (sigma, 0usize);
     let mut found: Vec<Mat<f64>> = Vec::new();
-    let mut total_found = 0;
     let mut factor_seconds = 0.0;
     let mut ritz_checks = 0;
     let mut max_basis_used = 0;
     while lower.1 < k {
         let t = Instant::now();
         let mut upper = lower.0 + step;
-        let mut below = factor_at(upper, &mut a)?.below;
+        let mut below = pencil.factor(upper)?.below;
         // Too many eigenvalues in the slice: shrink the step until the count is reasonable.
         while below - lower.1 > 2 * q {
             step *= 0.5;
             upper = lower.0 + step;
-            below = factor_at(upper, &mut a)?.below;
+            below = pencil.factor(upper)?.below;
         }
         let count = below - lower.1;
         if count > 0 {
             // Solve at the slice's midpoint: its far ends are half a slice away.
             let mu = 0.5 * (lower.0 + upper);
-            let f = factor_at(mu, &mut a)?;
+            let f = pencil.factor(mu)?;
             factor_seconds += t.elapsed().as_secs_f64();
             let (vectors, basis, checks) = slice_lanczos(
-                &symbolic,
+                &pencil.symbolic,
                 &f,
                 &sqrt_m,
                 mu,
@@ -215,7 +228,6 @@ pub(crate) fn sliced_eigenpairs(
             )?;
             ritz_checks += checks;
             max_basis_used = max_basis_used.max(basis);
-            total_found += vectors.ncols();
             found.push(vectors);
             step *= (q as f64 / count as f64).clamp(0.5, 2.0);
         } else {
@@ -226,12 +238,7 @@ pub(crate) fn sliced_eigenpairs(
     }
 
     // Global Rayleigh-Ritz over all slices.
-    let mut x = Mat::<f64>::zeros(n, total_found);
-    let mut col = 0;
-    for v in &found {
-        x.as_mut().subcols_mut(col, v.ncols()).copy_from(v);
-        col += v.ncols();
-    }
+    let x = concat_columns(n, &found);
     drop(found);
     let pairs = global_rayleigh_ritz(matrices, &x, k, par)?;
     let report = SolveReport {

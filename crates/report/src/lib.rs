@@ -1,6 +1,7 @@
 //! Result tables and figures from evaluated runs: pure functions from in-memory
-//! [`RunRecord`]s to Markdown, LaTeX and PNG bytes (no file access; the caller finds the runs
-//! and writes the outputs).
+//! [`RunRecord`]s to Markdown, LaTeX and PNG bytes (no file access; the experiments crate's
+//! `collect` finds the runs and writes the outputs). The last stage of the data flow: it knows
+//! the models' names and the metrics' aggregation, nothing about training or scenes.
 //!
 //! * [`record`]: [`RunRecord`] (model, options, data set, object, metrics) and its vocabulary.
 //! * [`average`]: each run's last evaluation, averages per object then over objects, paired
@@ -13,16 +14,16 @@
 //! * [`deltas`]: the ablations (NOL, reciprocity options, angle parametrization, NeRFactor
 //!   changes) as differences to the baseline.
 //! * [`plot`], [`grid`], [`figures`]: line plots (error against training time) and image
-//!   grids (qualitative comparisons, FLIP maps, diffuse / specular / albedo splits), drawn on
-//!   a [`canvas`] with the embedded bitmap [`font`].
+//!   grids (qualitative comparisons, FLIP maps, diffuse / specular / albedo splits), drawn with
+//!   plotters into a [`raster`] with the embedded TTF [`font`] (DejaVu Sans).
 //!
 //! Conventions: cells print `–` for a combination that was not run and `n/a` for a metric
 //! that could not be computed (its reason is listed under the table); every caption names the
 //! data and the profile.
 
 pub mod average;
-pub mod canvas;
 pub mod deltas;
+mod error;
 pub mod figures;
 pub mod font;
 pub mod grid;
@@ -30,6 +31,7 @@ pub mod latex;
 pub mod markdown;
 pub mod plot;
 pub mod rank;
+pub mod raster;
 pub mod record;
 pub mod runtime;
 pub mod table;
@@ -38,6 +40,7 @@ pub mod tables;
 pub use deltas::{
     Variant, nerfactor_deltas, nol_deltas, parametrization_deltas, reciprocity_deltas,
 };
+pub use error::{Error, Result};
 pub use figures::{ModelRender, QualitativeRow, qualitative_grid, runtime_plot};
 pub use grid::{GridCell, GridRow, ImageGrid, RgbImage, image_grid_png};
 pub use latex::{LATEX_PREAMBLE, to_latex};

@@ -5,7 +5,8 @@ use crate::error::{Error, Result};
 use mesh_encoding::TriMesh;
 use std::path::Path;
 
-/// The mesh as binary PLY bytes.
+/// The mesh as binary PLY bytes. The header's comment names dataset-merl, where the format was
+/// born: it is part of every scene's bytes (so of every run id) and stays as it is.
 pub fn ply_bytes(mesh: &TriMesh) -> Vec<u8> {
     let header = format!(
         "ply\nformat binary_little_endian 1.0\ncomment written by dataset-merl\n\

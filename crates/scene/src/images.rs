@@ -1,5 +1,10 @@
 //! Image files of a scene: linear HDR RGB as float EXR (ZIP compressed), masks and flags as 8-bit
-//! grayscale PNG.
+//! grayscale PNG, previews as 8-bit sRGB PNG.
+//!
+//! The `*_bytes` functions encode in memory (`path` only names the file in errors); the
+//! `write_*` functions encode and write plainly, which is right inside a scene directory that is
+//! assembled under a temporary name. Files that stand alone (evaluation renders) are written
+//! with `stdx::fs::write_atomic` from the encoded bytes.
 
 use crate::error::{Error, Result};
 use exr::prelude::*;
@@ -38,6 +43,16 @@ pub fn write_exr_rgb(
     height: usize,
     rgb: &[[f32; 3]],
 ) -> Result<Vec<u8>> {
+    write_bytes(path, exr_rgb_bytes(path, width, height, rgb)?)
+}
+
+/// A row-major RGB f32 image encoded as EXR (ZIP compression, lossless).
+pub fn exr_rgb_bytes(
+    path: &Path,
+    width: usize,
+    height: usize,
+    rgb: &[[f32; 3]],
+) -> Result<Vec<u8>> {
     if rgb.len() != width * height {
         return Err(image_err(path, format!("{} pixels for {width} x {height}", rgb.len())));
     }
@@ -51,7 +66,7 @@ pub fn write_exr_rgb(
         .non_parallel()
         .to_buffered(&mut buf)
         .map_err(|e| image_err(path, e))?;
-    write_bytes(path, buf.into_inner())
+    Ok(buf.into_inner())
 }
 
 /// Reads an RGB EXR file: (width, height, row-major pixels). Non-finite values are an error.
@@ -109,6 +124,11 @@ pub fn srgb8(linear: f32) -> u8 {
 /// Writes a linear RGB image as an 8-bit sRGB PNG (values clamped to [0, 1]), for viewing;
 /// returns the bytes written.
 pub fn write_png_srgb(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<Vec<u8>> {
+    write_bytes(path, png_srgb_bytes(path, width, height, rgb)?)
+}
+
+/// A linear RGB image encoded as an 8-bit sRGB PNG (values clamped to [0, 1]).
+pub fn png_srgb_bytes(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<Vec<u8>> {
     let bytes: Vec<u8> = rgb.iter().flat_map(|p| p.map(srgb8)).collect();
-    write_bytes(path, encode_png(path, &bytes, width, height, image::ExtendedColorType::Rgb8)?)
+    encode_png(path, &bytes, width, height, image::ExtendedColorType::Rgb8)
 }

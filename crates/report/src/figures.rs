@@ -142,17 +142,17 @@ pub fn qualitative_grid(title: &str, rows: &[QualitativeRow]) -> ImageGrid {
         title: title.to_string(),
         column_headers: headers,
         rows: grid_rows,
-        font_scale: 2,
+        font_px: 16,
         padding: 8,
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::super::canvas::BLACK;
-    use super::super::grid::image_grid_png;
-    use super::super::plot::line_plot_png;
     use super::*;
+    use crate::grid::image_grid_png;
+    use crate::plot::line_plot_png;
+    use crate::raster::BLACK;
 
     #[test]
     fn runtime_curves_per_model_and_budget() {

@@ -1,10 +1,21 @@
-//! What a semi-synthetic scene is made of: mesh, material, seed and settings (spec section 6 and
-//! the decisions table). Every value is configurable; the defaults are the paper's setup.
+//! What a scene is made of: mesh, material, seed and settings (spec section 6 and the decisions
+//! table). Every value is configurable; the defaults are the paper's semi-synthetic setup.
+//! Captured scenes record the same description with the capture's values.
 
 use crate::error::{Error, Result};
-use crate::merl::Lookup;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
+
+/// How a tabulated (MERL) BRDF is sampled between its bins.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Lookup {
+    /// The reference reader's rule: the bin containing the angles, no interpolation.
+    #[default]
+    NearestLower,
+    /// Trilinear interpolation between bin lower edges (periodic in phi_d).
+    Trilinear,
+}
 
 /// The material rendered onto the mesh.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -158,7 +169,8 @@ impl SceneConfig {
         Ok(c)
     }
 
-    /// Checks every value; the error names the key.
+    /// Checks every value; the error names the key. Whether a MERL material name exists is the
+    /// generator's question (dataset-merl's catalogue), not the format's.
     pub fn validate(&self) -> Result<()> {
         let s = &self.settings;
         let bad = |key: &str, fault: String| Err(Error::Config { key: key.into(), fault });
@@ -212,8 +224,10 @@ impl SceneConfig {
         {
             return bad("material.albedo", format!("{albedo:?} is not in [0, 1]"));
         }
-        if let MaterialSpec::Merl { name } = &self.material {
-            crate::catalogue::entry(name)?;
+        if let MaterialSpec::Merl { name } = &self.material
+            && name.trim().is_empty()
+        {
+            return bad("material.name", "is empty".into());
         }
         Ok(())
     }

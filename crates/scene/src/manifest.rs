@@ -5,7 +5,7 @@
 //! hash, and summary statistics. Its own `checksum` (xxh3-64 of the manifest serialised with the
 //! checksum field empty) makes any edit detectable; every listed file is checked on open.
 
-use super::config::SceneConfig;
+use crate::config::SceneConfig;
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -13,7 +13,7 @@ use std::path::Path;
 /// Format name in every manifest.
 pub const FORMAT: &str = "neural-brdf-scene";
 /// Current format version. 2: semi-synthetic scenes carry the noise-free test renders
-/// (`clean/`), and their radiance is formed in f32 by `render::shade`.
+/// (`clean/`), and their radiance is formed in f32 by [`shade`](crate::shading::shade).
 pub const VERSION: u32 = 2;
 /// The manifest's file name inside a scene directory.
 pub const MANIFEST_FILE: &str = "manifest.json";
@@ -100,6 +100,30 @@ pub struct SceneStats {
 }
 
 impl SceneStats {
+    /// The sample counts of one flags image ([`flag`](crate::flag) bits per pixel); an invalid
+    /// ground truth is a lit sample without `GT_VALID`.
+    pub fn count_flags(flags: &[u8]) -> Self {
+        use crate::flag::{BACK_FACING, GT_VALID, LIT, SATURATED, SHADOWED};
+        let mut st = Self::default();
+        for &f in flags {
+            st.lit_samples += u64::from(f & LIT != 0);
+            st.shadowed_samples += u64::from(f & SHADOWED != 0);
+            st.back_facing_samples += u64::from(f & BACK_FACING != 0);
+            st.saturated_samples += u64::from(f & SATURATED != 0);
+            st.invalid_gt_samples += u64::from(f & LIT != 0 && f & GT_VALID == 0);
+        }
+        st
+    }
+
+    /// Adds the sample counts of `other` (not its pixels or fraction).
+    pub fn add_counts(&mut self, other: &Self) {
+        self.lit_samples += other.lit_samples;
+        self.shadowed_samples += other.shadowed_samples;
+        self.back_facing_samples += other.back_facing_samples;
+        self.saturated_samples += other.saturated_samples;
+        self.invalid_gt_samples += other.invalid_gt_samples;
+    }
+
     /// Sets `saturated_fraction` from the counts, rounded to 1e-12 so that it survives the
     /// manifest's JSON round trip bit for bit: serde_json's default float parser is exact only
     /// for decimals of at most 15 significant digits, and the manifest's checksum is taken over

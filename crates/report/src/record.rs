@@ -1,7 +1,7 @@
 //! One evaluated run as the tables see it: model, options, dataset, object and its metrics.
 //!
 //! The lead collects these from run directories (`metrics.json`, the energy and reciprocity
-//! analyses); everything in [`crate::report`] is a pure function of a slice of them.
+//! analyses); everything in [this crate](crate) is a pure function of a slice of them.
 
 use brdf_neural::{AngleParametrization, ModelConfig, ModelKind, Reciprocity};
 use metrics::aggregate::{Score, TableScale};
@@ -247,7 +247,7 @@ pub struct RunRecord {
     /// The object (scene) name; averages are taken per object first.
     pub object: String,
     /// Training steps of the evaluated weights; `None` for the final weights. Tables use each
-    /// run's last evaluation ([`crate::report::average::final_records`]); run-time curves use
+    /// run's last evaluation ([`crate::average::final_records`]); run-time curves use
     /// all of them.
     pub steps: Option<u64>,
     /// Raw metric values; a metric left out was not measured.

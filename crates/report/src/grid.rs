@@ -4,13 +4,18 @@
 //!
 //! Layout: every slot is as wide as the widest image or caption and as tall as the tallest
 //! image; each image is centred in its slot, its caption centred below. [`grid_geometry`]
-//! returns the positions, so callers (and tests) can find any cell.
+//! returns the positions, so callers (and tests) can find any cell. Images are copied into the
+//! raster as they are; text is drawn by plotters with the embedded font.
 
-use super::canvas::{BLACK, Canvas, Rgb, WHITE};
-use super::font::{GLYPH_SIZE, text_width};
-use crate::{Error, Result};
+use crate::error::{Error, Result};
+use crate::font::{ensure_registered, font, text_size};
+use crate::raster::{BLACK, Raster, Rgb, draw_error};
 use metrics::colormap::error_map_rgb8;
 use metrics::srgb::oetf_clamped;
+use plotters::coord::Shift;
+use plotters::prelude::{BitMapBackend, DrawingArea, IntoDrawingArea, RGBColor};
+use plotters::style::TextStyle;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 /// An 8-bit sRGB image, row-major.
 #[derive(Clone, Debug, PartialEq)]
@@ -24,7 +29,7 @@ impl RgbImage {
     /// Wraps `width * height` pixels.
     pub fn new(width: u32, height: u32, pixels: Vec<Rgb>) -> Result<Self> {
         if (width as usize).checked_mul(height as usize) != Some(pixels.len()) {
-            return Err(Error::config(
+            return Err(Error::figure(
                 "report.image",
                 format!("{} pixels for a {width} x {height} image", pixels.len()),
             ));
@@ -109,8 +114,8 @@ pub struct ImageGrid {
     pub column_headers: Vec<String>,
     /// The rows.
     pub rows: Vec<GridRow>,
-    /// Integer scale of the 8 px font (default 2).
-    pub font_scale: u32,
+    /// Text size in pixels (default 16).
+    pub font_px: u32,
     /// Gap between slots and around the grid in pixels (default 8).
     pub padding: u32,
 }
@@ -135,7 +140,7 @@ impl ImageGrid {
                         .collect(),
                 })
                 .collect(),
-            font_scale: 2,
+            font_px: 16,
             padding: 8,
         }
     }
@@ -144,9 +149,9 @@ impl ImageGrid {
 /// Where everything of a grid goes, in pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct GridGeometry {
-    /// Canvas width.
+    /// Raster width.
     pub width: i64,
-    /// Canvas height.
+    /// Raster height.
     pub height: i64,
     /// Left edge of the first column.
     pub left: i64,
@@ -179,20 +184,23 @@ impl GridGeometry {
 }
 
 /// The layout of `grid`.
-pub fn grid_geometry(grid: &ImageGrid) -> GridGeometry {
-    let fs = grid.font_scale.clamp(1, 16);
-    let gh = i64::from(GLYPH_SIZE * fs);
+pub fn grid_geometry(grid: &ImageGrid) -> Result<GridGeometry> {
+    let px = grid.font_px.clamp(6, 128);
+    let gh = i64::from(px);
     let pad = i64::from(grid.padding.min(1024));
     let cells = || grid.rows.iter().flat_map(|r| r.cells.iter());
     let img_w = cells().filter_map(|c| c.image.as_ref()).map(|i| i64::from(i.width)).max();
     let img_h = cells().filter_map(|c| c.image.as_ref()).map(|i| i64::from(i.height)).max();
-    let text_w = |s: &String| i64::from(text_width(s, fs));
-    let caption_w = cells().map(|c| text_w(&c.caption)).max().unwrap_or(0);
-    let header_w = grid.column_headers.iter().map(text_w).max().unwrap_or(0);
+    let text_w = |s: &String| text_size(s, px).map(|(w, _)| i64::from(w));
+    let widest = |texts: &mut dyn Iterator<Item = &String>| -> Result<i64> {
+        texts.map(text_w).try_fold(0, |m, w| Ok(m.max(w?)))
+    };
+    let caption_w = widest(&mut cells().map(|c| &c.caption))?;
+    let header_w = widest(&mut grid.column_headers.iter())?;
     let slot_width = img_w.unwrap_or(0).max(caption_w).max(header_w).max(1);
     let slot_height = img_h.unwrap_or(0).max(1);
     let has_captions = cells().any(|c| !c.caption.is_empty());
-    let label_w = grid.rows.iter().map(|r| text_w(&r.label)).max().unwrap_or(0);
+    let label_w = widest(&mut grid.rows.iter().map(|r| &r.label))?;
     let columns =
         grid.rows.iter().map(|r| r.cells.len()).max().unwrap_or(0).max(grid.column_headers.len());
     let title_h = if grid.title.is_empty() { 0 } else { gh + pad };
@@ -201,8 +209,8 @@ pub fn grid_geometry(grid: &ImageGrid) -> GridGeometry {
     let top = pad + title_h + header_h;
     let column_step = slot_width + pad;
     let row_step = slot_height + if has_captions { pad / 2 + gh } else { 0 } + pad;
-    let title_w = text_w(&grid.title) + 2 * pad;
-    GridGeometry {
+    let title_w = text_w(&grid.title)? + 2 * pad;
+    Ok(GridGeometry {
         width: (left + columns as i64 * column_step).max(title_w),
         height: top + grid.rows.len() as i64 * row_step,
         left,
@@ -212,38 +220,61 @@ pub fn grid_geometry(grid: &ImageGrid) -> GridGeometry {
         column_step,
         row_step,
         columns,
-    }
+    })
 }
 
-/// Draws the grid on a white canvas.
-pub fn draw_image_grid(grid: &ImageGrid) -> Result<Canvas> {
-    let g = grid_geometry(grid);
-    let side = |v: i64| u32::try_from(v.max(1)).unwrap_or(u32::MAX);
-    let mut canvas = Canvas::new(side(g.width), side(g.height), WHITE)?;
-    let fs = grid.font_scale.clamp(1, 16);
-    let gh = i64::from(GLYPH_SIZE * fs);
-    let pad = i64::from(grid.padding.min(1024));
-    if !grid.title.is_empty() {
-        canvas.text_centered(g.width / 2, pad, &grid.title, fs, BLACK);
+/// Draws `text` in black at `px` pixels with its top at `y`, anchored at `x` as `h` says.
+fn text(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    text: &str,
+    (x, y): (i64, i64),
+    px: u32,
+    h: HPos,
+) -> Result<()> {
+    if text.is_empty() {
+        return Ok(());
     }
+    let black = RGBColor(BLACK[0], BLACK[1], BLACK[2]);
+    let style = TextStyle::from(font(px)).color(&black).pos(Pos::new(h, VPos::Top));
+    let at = |v: i64| v.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32;
+    area.draw_text(text, &style, (at(x), at(y))).map_err(draw_error)
+}
+
+/// Draws the grid on a white raster.
+pub fn draw_image_grid(grid: &ImageGrid) -> Result<Raster> {
+    ensure_registered()?;
+    let g = grid_geometry(grid)?;
+    let side = |v: i64| u32::try_from(v.max(1)).unwrap_or(u32::MAX);
+    let mut raster = Raster::new(side(g.width), side(g.height))?;
+    for (r, row) in grid.rows.iter().enumerate() {
+        for (c, cell) in row.cells.iter().enumerate() {
+            if let Some(img) = &cell.image {
+                let (ix, iy) = g.image_origin(r, c, img.width, img.height);
+                raster.blit(ix, iy, img.width, img.height, &img.pixels);
+            }
+        }
+    }
+    let px = grid.font_px.clamp(6, 128);
+    let (gh, pad) = (i64::from(px), i64::from(grid.padding.min(1024)));
+    let (w, h) = (raster.width, raster.height);
+    let area = BitMapBackend::with_buffer(&mut raster.bytes, (w, h)).into_drawing_area();
+    text(&area, &grid.title, (g.width / 2, pad), px, HPos::Center)?;
     for (c, header) in grid.column_headers.iter().enumerate() {
         let (x, y) = g.slot_origin(0, c);
-        canvas.text_centered(x + g.slot_width / 2, y - pad / 2 - gh, header, fs, BLACK);
+        text(&area, header, (x + g.slot_width / 2, y - pad / 2 - gh), px, HPos::Center)?;
     }
     for (r, row) in grid.rows.iter().enumerate() {
         let (_, y) = g.slot_origin(r, 0);
-        canvas.text(pad, y + g.slot_height / 2 - gh / 2, &row.label, fs, BLACK);
+        text(&area, &row.label, (pad, y + g.slot_height / 2 - gh / 2), px, HPos::Left)?;
         for (c, cell) in row.cells.iter().enumerate() {
             let (x, y) = g.slot_origin(r, c);
-            if let Some(img) = &cell.image {
-                let (ix, iy) = g.image_origin(r, c, img.width, img.height);
-                canvas.blit(ix, iy, img.width, img.height, &img.pixels);
-            }
-            let cy = y + g.slot_height + pad / 2;
-            canvas.text_centered(x + g.slot_width / 2, cy, &cell.caption, fs, BLACK);
+            let at = (x + g.slot_width / 2, y + g.slot_height + pad / 2);
+            text(&area, &cell.caption, at, px, HPos::Center)?;
         }
     }
-    Ok(canvas)
+    area.present().map_err(draw_error)?;
+    drop(area);
+    Ok(raster)
 }
 
 /// The grid as PNG bytes.
@@ -273,7 +304,7 @@ mod tests {
             .collect();
         let headers = vec!["GT".to_string(), "Disney".into(), "RP".into()];
         let grid = ImageGrid::from_images("Qualitative", headers, rows);
-        let g = grid_geometry(&grid);
+        let g = grid_geometry(&grid).unwrap();
         let png = image_grid_png(&grid).unwrap();
         let img = image::load_from_memory(&png).unwrap().to_rgb8();
         assert_eq!((i64::from(img.width()), i64::from(img.height())), (g.width, g.height));
@@ -304,7 +335,7 @@ mod tests {
             vec![("r".into(), vec![("x".into(), RgbImage::filled(4, 4, BLACK))])],
         );
         grid.rows[0].cells.push(GridCell { image: None, caption: "missing".into() });
-        assert_eq!(grid_geometry(&grid).columns, 3);
+        assert_eq!(grid_geometry(&grid).unwrap().columns, 3);
         assert!(image_grid_png(&grid).is_ok());
     }
 

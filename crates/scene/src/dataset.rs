@@ -5,12 +5,12 @@
 //! cache, rebuilt if damaged), and [`SceneDataset::samples`] gathers the lit foreground
 //! (pixel, light) records of a split as a struct of arrays.
 
-use super::generate::sample_stem;
-use super::images;
-use super::manifest::{MANIFEST_FILE, Manifest, Split};
-use super::mesh_file;
-use super::render::flag;
 use crate::error::{Error, Result};
+use crate::flag;
+use crate::images;
+use crate::manifest::{MANIFEST_FILE, Manifest, Split};
+use crate::mesh_file;
+use crate::writer::sample_stem;
 use glam::Vec3;
 use mesh_encoding::TriMesh;
 use raycast_precompute::{

@@ -4,46 +4,17 @@
 //! Only lit samples evaluate the BRDF: background pixels are not traced, and shadowed or
 //! back-facing samples carry no information about it.
 //!
-//! The radiance is formed in f32 by [`shade`] from the f32 BRDF value that is stored in the
+//! The radiance is formed in f32 by [`shade`] (the scene format's rendering equation) from the f32 BRDF value that is stored in the
 //! scene, the f32 shading normal and light direction: the same function, on the same values,
 //! that training and evaluation use. A model that returns the stored ground-truth BRDF
 //! therefore renders the scene's noise-free image bit for bit (its noise ceiling is exact).
 
 use raycast_precompute::{LightState, ViewPrecompute};
-
-/// Bits of the per-sample flags image.
-pub mod flag {
-    /// The light reaches the point (BRDF evaluated).
-    pub const LIT: u8 = 1;
-    /// The point is in shadow.
-    pub const SHADOWED: u8 = 2;
-    /// Light or view below the shading surface.
-    pub const BACK_FACING: u8 = 4;
-    /// The ground-truth BRDF is valid.
-    pub const GT_VALID: u8 = 8;
-    /// A channel reached the saturation level.
-    pub const SATURATED: u8 = 16;
-}
+use scene::flag;
+use scene::shading::{light_weight, shade};
 
 /// The ground-truth BRDF: local-frame (l, v) to RGB in 1/sr, `None` where invalid.
 pub type GroundTruth<'a> = dyn Fn([f64; 3], [f64; 3]) -> Option<[f64; 3]> + Sync + 'a;
-
-/// E cos(theta_l) per channel for a unit shading normal `n` and light direction `l` (world
-/// space, f32), `None` when cos(theta_l) is not positive: the factor a BRDF value is
-/// multiplied by to render a directional light (spec 6).
-pub fn light_weight(irradiance: [f32; 3], n: [f32; 3], l: [f32; 3]) -> Option<[f32; 3]> {
-    let cos = n[0] * l[0] + n[1] * l[1] + n[2] * l[2];
-    if cos.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-        return None;
-    }
-    Some([irradiance[0] * cos, irradiance[1] * cos, irradiance[2] * cos])
-}
-
-/// The radiance L = f E cos(theta_l) of a BRDF value `f` under a light of weight `w`
-/// ([`light_weight`]).
-pub fn shade(f: [f32; 3], w: [f32; 3]) -> [f32; 3] {
-    [f[0] * w[0], f[1] * w[1], f[2] * w[2]]
-}
 
 /// One rendered (view, light) image, full frame, row-major.
 pub struct LightImage {
