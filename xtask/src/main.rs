@@ -103,8 +103,9 @@ enum Command {
         /// Output directory (scenes, runs, cache, tables, figures).
         #[arg(long, default_value = "out/reproduce")]
         out: PathBuf,
-        /// Runs at a time, as child processes (1: in this process).
-        #[arg(long, default_value_t = 1)]
+        /// Runs at a time, as child processes (1: in this process). Two use a 2-core machine
+        /// fully (one training run keeps about 1.5 cores busy).
+        #[arg(long, default_value_t = 2)]
         jobs: usize,
         /// Write one shell command per unfinished run to this file (e.g. for a Slurm job array)
         /// instead of running them; then `cargo xtask collect`.

@@ -130,7 +130,7 @@ pub fn table1(records: &[RunRecord], ceiling: &[RunRecord], profile: &str) -> Ta
              and RMSE∛ ×100 (RMSE∛ only where a ground-truth BRDF exists). The ground truth's \
              own noise-free renders score the noise ceiling, the best any model can; \
              'below ceiling' is its PSNR minus the model's; time is the training wall time \
-             per run.",
+             per run (runs trained side by side, `--jobs` > 1, shared the machine's cores).",
             &data,
             profile,
         ),
