@@ -37,6 +37,9 @@ pub struct CheckpointState {
     /// Set once training has stopped early (the checkpoint of the last step).
     #[serde(default)]
     pub stopped: Option<crate::plateau::StopReason>,
+    /// Seconds per phase of the step so far.
+    #[serde(default)]
+    pub phases: crate::profile::StepPhases,
 }
 
 /// Writes a checkpoint atomically and removes the older ones; returns its folder.

@@ -246,6 +246,10 @@ pub struct RunMetrics {
     /// Test metrics (`eval`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub test: Option<crate::eval::TestMetrics>,
+    /// Where the training time went, seconds per phase of the step (absent in runs trained
+    /// before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub phases: Option<crate::profile::StepPhases>,
 }
 
 impl RunMetrics {

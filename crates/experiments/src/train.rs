@@ -261,6 +261,7 @@ fn run_metrics(
         parameters: config.model.param_count(),
         snapshots: state.snapshots.clone(),
         test: None,
+        phases: Some(state.phases.clone()),
     }
 }
 

@@ -12,6 +12,7 @@ use crate::data::TrainingData;
 use crate::diagnose::{all_finite, diagnose};
 use crate::loss::{LossWeights, loss, srgb_oetf};
 use crate::plateau::{Decision, StopReason};
+use crate::profile::{Phase, PhaseTimer};
 use crate::run_dir::{CurveRow, RunDir, Snapshot, write_curve};
 use crate::{Error, Result};
 use brdf_neural::{BrdfModel, Reciprocity, Samples};
@@ -77,16 +78,21 @@ impl Loop<'_> {
         let t = &self.config.train;
         let (start, seconds_before) = (Instant::now(), state.seconds);
         let mut window = (Instant::now(), state.step);
+        let mut timer = PhaseTimer::start(std::mem::take(&mut state.phases));
         while state.step < t.iterations && state.stopped.is_none() {
             let step = state.step;
             if let Some(h) = hook.as_mut() {
                 model = h(step, model);
             }
             let lr = t.lr_at(step) * state.plateau.lr_scale;
+            timer.charge(Phase::Bookkeeping);
             let value;
-            (model, value) = self.step(model, optim, step, lr, &last_checkpoint)?;
+            (model, value) = self.step(model, optim, (step, lr), &last_checkpoint, &mut timer)?;
             state.step += 1;
             let val_loss = self.maybe_validate(&model, &mut state)?;
+            timer.charge(Phase::Validation);
+            timer.end_step();
+            state.phases = timer.phases().clone();
             let seconds = seconds_before + start.elapsed().as_secs_f64();
             if state.step.is_multiple_of(t.log_every) || val_loss.is_some() {
                 state.curve.push(CurveRow { step: state.step, loss: value, val_loss, lr, seconds });
@@ -113,17 +119,20 @@ impl Loop<'_> {
                 return Ok(LoopEnd::Interrupted(state.step));
             }
         }
+        timer.charge(Phase::Bookkeeping);
+        state.phases = timer.phases().clone();
         Ok(LoopEnd::Done(Box::new((model, state))))
     }
 
-    /// One optimiser step at rate `lr`: the batch of `step`, the loss, its gradient, Adam.
+    /// One optimiser step number `step` at rate `lr`: the batch of `step`, the loss, its
+    /// gradient, Adam; `timer` is charged with each phase.
     fn step(
         &self,
         model: BrdfModel,
         optim: &mut ModuleOptimizer,
-        step: u64,
-        lr: f64,
+        (step, lr): (u64, f64),
         last_checkpoint: &Option<PathBuf>,
+        timer: &mut PhaseTimer,
     ) -> Result<(BrdfModel, f32)> {
         let (t, c) = (&self.config.train, &self.config.model);
         let bs = t.batch_size;
@@ -131,13 +140,16 @@ impl Loop<'_> {
         let n = self.data.len();
         let indices: Vec<usize> = (0..bs).map(|_| rng.random_range(0..n)).collect();
         let cpu = self.data.gather(&indices);
+        timer.charge(Phase::Gather);
         let swap = c.angles.reciprocity == Reciprocity::RandomSwap;
         let mask = swap.then(|| c.angles.swap_mask(bs, &mut rng));
         let samples = Samples { spatial: &cpu.spatial, l: &cpu.l, v: &cpu.v };
         let batch = c.batch(&samples, mask.as_deref(), &self.device)?;
         let weight = tensor(cpu.weight, bs, &self.device);
         let target = tensor(cpu.target_gamma, bs, &self.device);
+        timer.charge(Phase::Encode);
         let out = model.forward(&batch);
+        timer.charge(Phase::Forward);
         let weights = LossWeights {
             diffuse: t.diffuse_reg_weight,
             specular: t.specular_reg_weight,
@@ -145,6 +157,7 @@ impl Loop<'_> {
         };
         let total = loss(&out, weight, target, c.kind.is_enhanced(), weights);
         let value: f32 = total.clone().into_scalar::<f32>();
+        timer.charge(Phase::Loss);
         if !value.is_finite() {
             self.bar.abandon();
             return Err(Error::NonFinite {
@@ -155,7 +168,10 @@ impl Loop<'_> {
             });
         }
         let grads = GradientsParams::from_grads(total.backward(), &model);
-        Ok((optim.step(lr, model, grads), value))
+        timer.charge(Phase::Backward);
+        let model = optim.step(lr, model, grads);
+        timer.charge(Phase::Optimizer);
+        Ok((model, value))
     }
 
     /// After every `validate_every` steps: the validation loss, fed to the plateau rule (which

@@ -28,6 +28,7 @@ pub use settings::{EnergyEstimator, EvalConfig, EvalSettings};
 
 use crate::Result;
 use crate::data::TrainingData;
+use crate::profile::EvalPhases;
 use crate::run_dir::{RunDir, RunMetrics, Snapshot};
 use metrics::rmse::{CubeRootRmse, RmseConfig};
 use scene::SampleSet;
@@ -90,6 +91,9 @@ pub struct TestMetrics {
     /// Wall-clock seconds of the whole evaluation.
     #[serde(default)]
     pub seconds: f64,
+    /// Where those seconds went (absent in older runs).
+    #[serde(default)]
+    pub phases: EvalPhases,
 }
 
 /// Only the energy analysis of a finished run, with `estimator` and `pairs` overriding the
@@ -201,10 +205,18 @@ pub fn eval_fitted(
     let (config, device, model, dataset) =
         (&fitted.config, &fitted.device, &fitted.model, &fitted.dataset);
     let settings = config.eval.resolve(config.train.profile);
+    let mut phases = EvalPhases::default();
+    let mut lap = Instant::now();
+    let mut charge = |phase: &mut f64| {
+        *phase += lap.elapsed().as_secs_f64();
+        lap = Instant::now();
+    };
     let (samples, data) = fitted.test_records()?;
+    charge(&mut phases.records);
     let parts = config.model.kind.is_additive() && settings.images;
     let pred = predict(model, &config.model, &data, device, parts)?;
     let (rmse_cbrt, rmse_samples) = cube_root_rmse(&samples, &data, &pred.f)?;
+    charge(&mut phases.predict);
 
     let (lpips, lpips_unavailable) = if settings.lpips_weights.is_file() {
         (Some(metrics::lpips::Lpips::load(&settings.lpips_weights, device)?), None)
@@ -226,12 +238,16 @@ pub fn eval_fitted(
         (None, Some(c)) => cached.write(c)?,
         (None, None) => {}
     }
+    charge(&mut phases.images);
     let brdf = ModelBrdf { model, config: &config.model, data: &data, device };
     let reciprocity_rmse = analyses::reciprocity(&brdf, &settings)?;
+    charge(&mut phases.reciprocity);
     let energy = analyses::energy(&brdf, &settings, config.seed, progress)?;
+    charge(&mut phases.energy);
     let path = RunDir::new(run).metrics();
     let mut all = RunMetrics::read(&path)?;
     let curve = snapshot_curve(fitted, run, &all.snapshots, (&samples, &data))?;
+    charge(&mut phases.curve);
     let test = TestMetrics {
         psnr: scores.model.psnr,
         dssim: scores.model.dssim,
@@ -247,6 +263,7 @@ pub fn eval_fitted(
         energy,
         curve,
         seconds: start.elapsed().as_secs_f64(),
+        phases,
     };
     all.test = Some(test.clone());
     all.write(&path)?;

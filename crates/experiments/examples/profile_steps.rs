@@ -1,0 +1,81 @@
+//! Where the time of a fit goes, per model kind: trains each run configuration of one scene of a
+//! finished sweep (for example the default's `out/reproduce`) for a fixed number of steps in a
+//! temporary directory, evaluates it, and prints milliseconds per step for each phase of the
+//! training step (`experiments::profile`) and seconds per phase of the evaluation.
+//!
+//! ```sh
+//! cargo xtask reproduce-tables            # once, for the scenes, caches and run configs
+//! cargo run --release -p experiments --example profile_steps -- out/reproduce spot__blue-acrylic 300
+//! ```
+//!
+//! Run it on a quiet machine (no compile: `pgrep -a rustc`). The runs are the sweep's own
+//! configurations with `iterations` set to the step count and snapshots off.
+
+use experiments::eval::eval_fitted;
+use experiments::eval::fitted::FittedRun;
+use experiments::run_dir::{RunDir, SweepLayout};
+use experiments::train::{FitOptions, fit_and_keep};
+use std::path::PathBuf;
+use std::time::Instant;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let [out, scene, rest @ ..] = args.as_slice() else {
+        return Err("usage: profile_steps <sweep out dir> <scene name> [steps]".into());
+    };
+    let steps: u64 = rest.first().map_or(Ok(300), |s| s.parse())?;
+    let layout = SweepLayout::new(out);
+    let mut runs: Vec<PathBuf> = std::fs::read_dir(layout.runs())?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            let name = p.file_name().unwrap_or_default().to_string_lossy().into_owned();
+            name.starts_with(&format!("{scene}__")) && name.contains("__default__")
+        })
+        .collect();
+    runs.sort();
+    if runs.is_empty() {
+        return Err(format!("no default runs of {scene} under {}", layout.runs().display()).into());
+    }
+    let tmp = std::env::temp_dir().join(format!("profile-steps-{}", std::process::id()));
+    println!("{steps} steps per model on {scene}; ms per step, then evaluation seconds\n");
+    println!(
+        "| model | gather | encode | forward | loss | backward | optimizer | validation | \
+         bookkeeping | total | samples/s |"
+    );
+    println!("| --- |{}", " ---: |".repeat(10));
+    let mut evals = Vec::new();
+    for template in &runs {
+        let mut config = RunDir::new(template).read_config()?;
+        config.train.iterations = steps;
+        config.train.snapshots = false;
+        let kind = format!("{:?}", config.model.kind);
+        let run = tmp.join(&kind);
+        let options =
+            FitOptions { progress: false, cache_dir: Some(layout.cache()), ..Default::default() };
+        let (outcome, trained) = fit_and_keep(&config, &run, options)?;
+        let trained = trained.ok_or_else(|| format!("{kind}: did not train ({outcome:?})"))?;
+        let metrics = experiments::run_dir::RunMetrics::read(&RunDir::new(&run).metrics())?;
+        let phases = metrics.phases.unwrap_or_default();
+        let cells: Vec<String> =
+            phases.per_step_ms().iter().map(|(_, ms)| format!("{ms:.1}")).collect();
+        let total = 1e3 * phases.total() / phases.steps.max(1) as f64;
+        println!(
+            "| {kind} | {} | {total:.1} | {:.0} |",
+            cells.join(" | "),
+            metrics.samples_per_second
+        );
+        let start = Instant::now();
+        let fitted = FittedRun::from_trained(config, trained, layout.cache());
+        let test = eval_fitted(&fitted, &run, false, start)?;
+        evals.push((kind, test));
+    }
+    println!("\n| model | records | predict | images | reciprocity | energy | curve | total (s) |");
+    println!("| --- |{}", " ---: |".repeat(7));
+    for (kind, test) in &evals {
+        let cells: Vec<String> =
+            test.phases.named().iter().map(|(_, s)| format!("{s:.2}")).collect();
+        println!("| {kind} | {} | {:.2} |", cells.join(" | "), test.seconds);
+    }
+    std::fs::remove_dir_all(&tmp).ok();
+    Ok(())
+}
