@@ -8,9 +8,14 @@ output (RGB); loss = MSE(f * w, target) with a per-sample weight w (E * shadow *
 backward; Adam (lr 1e-4). Batch 32768 by default. Inputs are random (the angle features'
 computation is not part of the timed step in either implementation).
 
-Usage: python3 benches/pytorch_step.py [--batch 32768] [--threads 2] [--reps 20] [--machine]
-Prints the median and mean step time in ms and samples/s.
+Usage: python3 benches/pytorch_step.py [--batch 32768] [--threads 2] [--reps 20] [--bf16] [--machine]
+Prints the median and mean step time in ms and samples/s. `--bf16` runs forward and loss under
+`torch.autocast("cpu", dtype=torch.bfloat16)` (bf16 matrix products through oneDNN, which uses
+AVX512-BF16 where the CPU has it; f32 master weights and Adam): what a mixed-precision path
+buys on this CPU.
 """
+
+import contextlib
 
 import argparse
 import statistics
@@ -49,6 +54,7 @@ def main():
     p.add_argument("--batch", type=int, default=32768)
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--reps", type=int, default=20)
+    p.add_argument("--bf16", action="store_true", help="bf16 autocast (mixed precision)")
     p.add_argument("--machine", action="store_true", help="print only 'median_ms <value>'")
     a = p.parse_args()
     torch.set_num_threads(a.threads)
@@ -59,9 +65,15 @@ def main():
     w = torch.rand(a.batch, 1) * 3
     target = torch.rand(a.batch, 3)
 
+    def precision():
+        if a.bf16:
+            return torch.autocast("cpu", dtype=torch.bfloat16)
+        return contextlib.nullcontext()
+
     def step():
         opt.zero_grad(set_to_none=True)
-        loss = ((model(x) * w - target) ** 2).mean()
+        with precision():
+            loss = ((model(x).float() * w - target) ** 2).mean()
         loss.backward()
         opt.step()
 
@@ -78,7 +90,8 @@ def main():
         print(f"median_ms {med * 1e3:.3f}")
         return
     print(
-        f"pytorch {torch.__version__} threads {torch.get_num_threads()} batch {a.batch} "
+        f"pytorch {torch.__version__} {'bf16 autocast' if a.bf16 else 'f32'} "
+        f"threads {torch.get_num_threads()} batch {a.batch} "
         f"params {n_params}: median {med * 1e3:.1f} ms, mean {statistics.mean(times) * 1e3:.1f} ms, "
         f"{a.batch / med:.0f} samples/s"
     )

@@ -14,6 +14,7 @@ mod reproduce;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
+use experiments::Backend;
 use std::path::PathBuf;
 
 /// Orchestration CLI of the neural-BRDF comparison workspace.
@@ -103,10 +104,11 @@ enum Command {
         /// Output directory (scenes, runs, cache, tables, figures).
         #[arg(long, default_value = "out/reproduce")]
         out: PathBuf,
-        /// Runs at a time, as child processes (1: in this process). Two use a 2-core machine
-        /// fully (one training run keeps about 1.5 cores busy).
-        #[arg(long, default_value_t = 2)]
-        jobs: usize,
+        /// Runs at a time, as child processes (1: in this process) [default: 2 on the CPU, where
+        /// two use a 2-core machine fully (one training run keeps about 1.5 cores busy); 1 on a
+        /// GPU].
+        #[arg(long)]
+        jobs: Option<usize>,
         /// Write one shell command per unfinished run to this file (e.g. for a Slurm job array)
         /// instead of running them; then `cargo xtask collect`.
         #[arg(long)]
@@ -114,6 +116,10 @@ enum Command {
         /// Data root for the profile's `data:` meshes (default: $NEURAL_BRDF_DATA, else ./data).
         #[arg(long)]
         data: Option<PathBuf>,
+        /// The burn backend of every run: `cpu` (default), `wgpu` or `cuda` (an xtask built with
+        /// `--features wgpu` or `cuda`). On a GPU, use `--jobs 1`.
+        #[arg(long, default_value = "cpu", value_parser = parse_backend)]
+        backend: Backend,
     },
     /// Build every table and figure from the evaluated run directories below PATHS.
     Collect {
@@ -135,6 +141,9 @@ enum Command {
         /// No progress bars.
         #[arg(long)]
         quiet: bool,
+        /// The burn backend (`cpu`, `wgpu`, `cuda`).
+        #[arg(long, default_value = "cpu", value_parser = parse_backend)]
+        backend: Backend,
     },
     /// Import a DiLiGenT capture (`pmsData/<obj>PNG`, the ball) or a DiLiGenT-MV object
     /// (`mvpmsData/<obj>PNG`) as a scene directory that `experiments fit` trains on.
@@ -156,6 +165,11 @@ enum Command {
     },
     /// Print the workspace's crates in layering order (bottom first).
     Layers,
+}
+
+/// `--backend`: a backend name (see `brdf_neural::device`).
+fn parse_backend(name: &str) -> std::result::Result<Backend, String> {
+    Backend::parse(name).map_err(|e| e.to_string())
 }
 
 fn main() -> Result<()> {
@@ -183,17 +197,18 @@ fn main() -> Result<()> {
         Command::FetchData { name, dest, only, list, allow_unverified, manifests } => {
             fetch::run(fetch::Options { name, dest, only, list, allow_unverified, manifests })?;
         }
-        Command::ReproduceTables { profile, out, jobs, emit_jobs, data } => {
+        Command::ReproduceTables { profile, out, jobs, emit_jobs, data, backend } => {
             reproduce::reproduce(reproduce::Options {
                 profile,
                 out,
-                jobs,
+                jobs: jobs.unwrap_or(if backend.is_gpu() { 1 } else { 2 }),
                 emit_jobs,
                 data_root: data.unwrap_or_else(reproduce::default_data_root),
+                backend,
             })?;
         }
         Command::Collect { paths, out, profile } => reproduce::collect(&paths, &out, &profile)?,
-        Command::RunOne { run, quiet } => reproduce::run_one(&run, !quiet)?,
+        Command::RunOne { run, quiet, backend } => reproduce::run_one(&run, !quiet, backend)?,
         Command::ImportDiligent { src, out, train_lights, test_lights, target_vertices } => {
             import_diligent::run(&src, &out, train_lights, test_lights, target_vertices)?;
         }

@@ -2,6 +2,7 @@
 //! command (see `experiments::sweep` for the profiles, the run layout and the tables).
 
 use anyhow::{Context, Result};
+use experiments::Backend;
 use experiments::run_dir::SweepLayout;
 use experiments::sweep::{self, Execution, SweepProfile};
 use std::path::{Path, PathBuf};
@@ -18,6 +19,8 @@ pub struct Options {
     pub emit_jobs: Option<PathBuf>,
     /// Data root for `data:` meshes.
     pub data_root: PathBuf,
+    /// The burn backend every run trains and evaluates on.
+    pub backend: Backend,
 }
 
 /// The data root: `NEURAL_BRDF_DATA`, else `./data`.
@@ -26,19 +29,26 @@ pub fn default_data_root() -> PathBuf {
 }
 
 /// The command that runs one run directory in a child process: this executable's `run-one`.
-fn run_one_command() -> Result<Vec<String>> {
+fn run_one_command(backend: Backend) -> Result<Vec<String>> {
     let exe = std::env::current_exe().context("locating the xtask executable")?;
-    Ok(vec![exe.display().to_string(), "run-one".into()])
+    Ok(vec![exe.display().to_string(), "run-one".into(), "--backend".into(), backend.to_string()])
 }
 
 /// Runs `reproduce-tables`.
 pub fn reproduce(opts: Options) -> Result<()> {
+    anyhow::ensure!(
+        opts.backend.is_built(),
+        "--backend {0}: this xtask was built without it; rebuild with `--features {0}`",
+        opts.backend
+    );
     let profile = SweepProfile::load(&opts.profile)?;
     eprintln!("profile {}: {}", profile.name, profile.description);
     let how = match (&opts.emit_jobs, opts.jobs) {
-        (Some(file), _) => Execution::Emit { file: file.clone(), command: run_one_command()? },
-        (None, 0 | 1) => Execution::InProcess,
-        (None, jobs) => Execution::Children { jobs, command: run_one_command()? },
+        (Some(file), _) => {
+            Execution::Emit { file: file.clone(), command: run_one_command(opts.backend)? }
+        }
+        (None, 0 | 1) => Execution::InProcess(opts.backend),
+        (None, jobs) => Execution::Children { jobs, command: run_one_command(opts.backend)? },
     };
     let s = sweep::sweep(&profile, &opts.out, &opts.data_root, &how)
         .with_context(|| format!("sweep {} into {}", profile.name, opts.out.display()))?;
@@ -98,6 +108,6 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<()> {
 }
 
 /// Runs `run-one` (what `--jobs` children and emitted job lines execute).
-pub fn run_one(dir: &Path, progress: bool) -> Result<()> {
-    sweep::run_one(dir, progress).with_context(|| format!("run {}", dir.display()))
+pub fn run_one(dir: &Path, progress: bool, backend: Backend) -> Result<()> {
+    sweep::run_one(dir, progress, backend).with_context(|| format!("run {}", dir.display()))
 }

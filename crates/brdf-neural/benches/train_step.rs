@@ -8,6 +8,8 @@
 //! - `BRDF_BENCH_BATCH` (default 32768);
 //! - `BRDF_BENCH_BACKENDS` (default: every CPU backend compiled in, e.g. `flex,ndarray`);
 //! - `BRDF_BENCH_QUICK=1` skips the criterion groups (summary only, about a minute);
+//! - `BRDF_BENCH_ALL_MODELS=1` adds the six other model kinds to the summary (their default
+//!   configurations; `docs/reproduce.md` sizes the `full` profile from these step times);
 //! - `BRDF_BENCH_PYTORCH=python3` (a Python with torch) also runs `benches/pytorch_step.py`,
 //!   the same Single MLP step in PyTorch on the same number of threads, back to back with
 //!   ours: three rounds of 10 steps each side after warm-up, and prints the ratios;
@@ -50,7 +52,7 @@ fn batch_size() -> usize {
 fn backends() -> Vec<Backend> {
     match std::env::var("BRDF_BENCH_BACKENDS") {
         Ok(s) => s.split(',').map(|b| Backend::parse(b).expect("backend")).collect(),
-        Err(_) => Backend::available().into_iter().filter(|b| *b != Backend::Wgpu).collect(),
+        Err(_) => Backend::available().into_iter().filter(|b| !b.is_gpu()).collect(),
     }
 }
 
@@ -59,11 +61,23 @@ fn configs() -> Vec<(&'static str, ModelConfig)> {
     single.angles.reciprocity = Reciprocity::Mapping;
     let mut shared = ModelConfig::new(ModelKind::AdditiveSharedEnhanced);
     shared.angles.reciprocity = Reciprocity::Mapping;
-    vec![
+    let mut out = vec![
         ("single_mlp", single),
         ("additive_shared_enhanced", shared),
         ("disney", ModelConfig::new(ModelKind::Disney)),
-    ]
+    ];
+    if std::env::var("BRDF_BENCH_ALL_MODELS").is_ok_and(|v| v == "1") {
+        // Every other kind in its default configuration (what a sweep trains).
+        for kind in ModelKind::ALL {
+            if ![ModelKind::SingleMlp, ModelKind::AdditiveSharedEnhanced, ModelKind::Disney]
+                .contains(&kind)
+            {
+                let name: &'static str = Box::leak(format!("{kind:?}").into_boxed_str());
+                out.push((name, ModelConfig::new(kind)));
+            }
+        }
+    }
+    out
 }
 
 /// Matrix-multiply FLOPs of one training step (forward + backward = 3x forward).
@@ -125,47 +139,110 @@ impl Step {
     }
 }
 
-/// The machine's FP32 matrix-multiply rate in GFLOP/s: the `gemm` crate (flex's kernels, all
-/// threads) into preallocated buffers, so allocation and copies are not part of it. Returns
-/// (square 2048 x 2048 x 2048, the step's dominant [n, 128] x [128, 128]); best of 10.
-fn machine_gemm_gflops(n: usize) -> (f64, f64) {
-    let rate = |m: usize, k: usize, p: usize| {
-        let a: Vec<f32> = (0..m * k).map(|i| ((i * 7 % 13) as f32 - 6.0) / 7.0).collect();
-        let b: Vec<f32> = (0..k * p).map(|i| ((i * 5 % 11) as f32 - 5.0) / 6.0).collect();
-        let mut c = vec![0f32; m * p];
+/// The machine's FP32 matrix-multiply rates in GFLOP/s: the `gemm` crate (flex's kernels) into
+/// preallocated buffers, so allocation and copies are not part of it; best of 11.
+struct GemmRates {
+    /// 2048 x 2048 x 2048, all threads.
+    square: f64,
+    /// The step's forward product [n, 128] x [128, 128], all threads.
+    forward: f64,
+    /// The weight gradient X^T dY, [128, n] (transposed view) x [n, 128], all threads: the
+    /// reduction runs over the batch.
+    weight_grad: f64,
+    /// The same product split over the batch in two halves, one thread each, then summed.
+    weight_grad_split: f64,
+}
+
+/// `c = a b` for `a` [m, k] with strides (`a_rs`, `a_cs`), `b` [k, p] row-major.
+///
+/// # Safety
+/// The buffers must hold the elements the strides address.
+#[allow(clippy::too_many_arguments)]
+unsafe fn gemm_into(
+    c: &mut [f32],
+    a: &[f32],
+    b: &[f32],
+    (m, k, p): (usize, usize, usize),
+    (a_rs, a_cs): (isize, isize),
+    threads: gemm::Parallelism,
+) {
+    // SAFETY: the caller's contract.
+    unsafe {
+        gemm::gemm(
+            m,
+            p,
+            k,
+            c.as_mut_ptr(),
+            1,
+            p as isize,
+            false,
+            a.as_ptr(),
+            a_cs,
+            a_rs,
+            b.as_ptr(),
+            1,
+            p as isize,
+            0.0,
+            1.0,
+            false,
+            false,
+            false,
+            threads,
+        );
+    }
+}
+
+fn machine_gemm_rates(n: usize) -> GemmRates {
+    let fill = |len: usize, s: usize| -> Vec<f32> {
+        (0..len).map(|i| ((i * s % 13) as f32 - 6.0) / 7.0).collect()
+    };
+    let best_of = |flops: f64, f: &mut dyn FnMut()| {
         let mut best = f64::INFINITY;
         for _ in 0..11 {
             let t = Instant::now();
-            // SAFETY: row-major buffers of exactly m x k, k x p and m x p elements.
-            unsafe {
-                gemm::gemm(
-                    m,
-                    p,
-                    k,
-                    c.as_mut_ptr(),
-                    1,
-                    p as isize,
-                    false,
-                    a.as_ptr(),
-                    1,
-                    k as isize,
-                    b.as_ptr(),
-                    1,
-                    p as isize,
-                    0.0,
-                    1.0,
-                    false,
-                    false,
-                    false,
-                    gemm::Parallelism::Rayon(0),
-                );
-            }
+            f();
             best = best.min(t.elapsed().as_secs_f64());
         }
-        std::hint::black_box(&c);
-        2.0 * (m * k * p) as f64 / best / 1e9
+        flops / best / 1e9
     };
-    (rate(2048, 2048, 2048), rate(n, 128, 128))
+    let all = gemm::Parallelism::Rayon(0);
+    let plain = |m: usize, k: usize, p: usize| {
+        let (a, b, mut c) = (fill(m * k, 7), fill(k * p, 5), vec![0f32; m * p]);
+        // SAFETY: row-major buffers of exactly m x k, k x p and m x p elements.
+        best_of(2.0 * (m * k * p) as f64, &mut || unsafe {
+            gemm_into(&mut c, &a, &b, (m, k, p), (k as isize, 1), all)
+        })
+    };
+    // X [n, 128] row-major, dY [n, 128]: dW = X^T dY, X^T read through strides (1, 128).
+    let (x, dy) = (fill(n * 128, 7), fill(n * 128, 5));
+    let mut dw = vec![0f32; 128 * 128];
+    let flops = 2.0 * (128 * n * 128) as f64;
+    // SAFETY: x and dy hold n x 128 elements each, dw 128 x 128.
+    let weight_grad = best_of(flops, &mut || unsafe {
+        gemm_into(&mut dw, &x, &dy, (128, n, 128), (1, 128), all)
+    });
+    let half = n / 2;
+    let mut other = vec![0f32; 128 * 128];
+    let weight_grad_split = best_of(flops, &mut || {
+        let (x0, x1) = x.split_at(half * 128);
+        let (d0, d1) = dy.split_at(half * 128);
+        let none = gemm::Parallelism::None;
+        rayon::join(
+            // SAFETY: each half holds its rows x 128 elements.
+            || unsafe { gemm_into(&mut dw, x0, d0, (128, half, 128), (1, 128), none) },
+            || unsafe { gemm_into(&mut other, x1, d1, (128, n - half, 128), (1, 128), none) },
+        );
+        for (a, b) in dw.iter_mut().zip(&other) {
+            *a += b;
+        }
+    });
+    std::hint::black_box((&dw, &other));
+    GemmRates {
+        square: plain(2048, 2048, 2048),
+        forward: plain(n, 128, 128),
+        weight_grad,
+        weight_grad_split,
+    }
 }
 
 /// Median step time in seconds over `reps` steps.
@@ -236,7 +313,8 @@ fn bench(cr: &mut Criterion) {
         }
         group.finish();
     }
-    let (square, step_shape) = machine_gemm_gflops(n);
+    let rates = machine_gemm_rates(n);
+    let square = rates.square;
     println!(
         "\nbatch {n}, threads: {} (RAYON_NUM_THREADS {:?}), host-memory policy active: {}",
         rayon_threads(),
@@ -245,7 +323,9 @@ fn bench(cr: &mut Criterion) {
     );
     println!(
         "machine FP32 gemm (gemm crate, preallocated): 2048^3 {square:.1} GFLOP/s, \
-         [{n}, 128] x [128, 128] {step_shape:.1} GFLOP/s"
+         [{n}, 128] x [128, 128] {:.1} GFLOP/s, weight gradient [128, {n}]^T x [{n}, 128] \
+         {:.1} GFLOP/s (split over the batch, one thread a half: {:.1} GFLOP/s)",
+        rates.forward, rates.weight_grad, rates.weight_grad_split
     );
     println!("| backend | model | step ms | samples/s | GFLOP/s | fraction of 2048^3 gemm |");
     println!("| --- | --- | ---: | ---: | ---: | ---: |");

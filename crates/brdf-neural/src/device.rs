@@ -1,14 +1,18 @@
 //! Run-time choice of the burn backend: the only place in the crate that names one.
 //!
 //! Models, batches and the tensor BRDFs take a [`Device`]; which backend runs them is decided
-//! here, from cargo features and, at run time, from [`Backend`] (for example parsed from a
-//! configuration or the `--backend` flag of a binary).
+//! here, from cargo features and, at run time, from [`Backend`] (parsed from the `--backend`
+//! flag of `experiments fit`/`eval` and `xtask reproduce-tables`).
 //!
-//! | backend | cargo feature | default | notes |
-//! | --- | --- | --- | --- |
-//! | `flex` | `flex` | yes | burn's pure-Rust CPU backend; fastest measured CPU backend here |
-//! | `ndarray` | `ndarray` | no | the design's original CPU backend, deprecated upstream |
-//! | `wgpu` | `wgpu` | no | GPU (Vulkan/Metal/DX12 through wgpu); not built in CI |
+//! | backend | `--backend` | cargo feature | default | notes |
+//! | --- | --- | --- | --- | --- |
+//! | `flex` | `cpu`, `flex` | `flex` | yes | burn's pure-Rust CPU backend; fastest measured CPU backend here |
+//! | `ndarray` | `ndarray` | `ndarray` | no | the design's original CPU backend, deprecated upstream |
+//! | `wgpu` | `wgpu` | `wgpu` | no | GPU through wgpu (Vulkan, Metal, DX12); tested on Mesa's software Vulkan (lavapipe) |
+//! | `cuda` | `cuda` | `cuda` | no | NVIDIA GPUs through CubeCL; builds without a CUDA toolkit (the driver is loaded at run time) |
+//!
+//! The GPU features go through the layers: `cargo build --release -p xtask --features wgpu`
+//! (or `cuda`) builds a `reproduce-tables` that accepts `--backend wgpu` (or `cuda`).
 //!
 //! The CPU devices made here also tell the C allocator to keep freed tensor buffers for reuse
 //! ([`crate::host_memory`]): 1.5 to 1.7x faster training steps on glibc, measured.
@@ -30,30 +34,70 @@ pub enum Backend {
     NdArray,
     /// burn-wgpu, GPU (feature `wgpu`).
     Wgpu,
+    /// CubeCL's CUDA runtime, NVIDIA GPUs (feature `cuda`).
+    Cuda,
+}
+
+impl Default for Backend {
+    /// The default CPU backend: flex when built, else ndarray.
+    fn default() -> Self {
+        if cfg!(feature = "flex") || !cfg!(feature = "ndarray") {
+            Backend::Flex
+        } else {
+            Backend::NdArray
+        }
+    }
+}
+
+impl std::fmt::Display for Backend {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 impl Backend {
+    /// Every backend, built or not.
+    pub const ALL: [Backend; 4] = [Backend::Flex, Backend::NdArray, Backend::Wgpu, Backend::Cuda];
+
     /// The backends compiled into this build, default first.
     pub fn available() -> Vec<Backend> {
-        let mut out = Vec::new();
-        if cfg!(feature = "flex") {
-            out.push(Backend::Flex);
-        }
-        if cfg!(feature = "ndarray") {
-            out.push(Backend::NdArray);
-        }
-        if cfg!(feature = "wgpu") {
-            out.push(Backend::Wgpu);
-        }
-        out
+        Self::ALL.into_iter().filter(|b| b.is_built()).collect()
     }
 
-    /// Parses `flex`, `ndarray` or `wgpu` (case-insensitive).
+    /// Whether this backend's cargo feature is on in this build.
+    pub fn is_built(self) -> bool {
+        match self {
+            Backend::Flex => cfg!(feature = "flex"),
+            Backend::NdArray => cfg!(feature = "ndarray"),
+            Backend::Wgpu => cfg!(feature = "wgpu"),
+            Backend::Cuda => cfg!(feature = "cuda"),
+        }
+    }
+
+    /// Whether the backend runs on a GPU.
+    pub fn is_gpu(self) -> bool {
+        matches!(self, Backend::Wgpu | Backend::Cuda)
+    }
+
+    /// The name [`Backend::parse`] reads (and `metrics.json` records).
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Flex => "flex",
+            Backend::NdArray => "ndarray",
+            Backend::Wgpu => "wgpu",
+            Backend::Cuda => "cuda",
+        }
+    }
+
+    /// Parses `cpu` (the default CPU backend), `flex`, `ndarray`, `wgpu` or `cuda`
+    /// (case-insensitive). A backend that is not built in parses; [`Backend::device`] refuses it.
     pub fn parse(name: &str) -> crate::Result<Backend> {
         match name.to_ascii_lowercase().as_str() {
+            "cpu" => Ok(Backend::default()),
             "flex" => Ok(Backend::Flex),
             "ndarray" => Ok(Backend::NdArray),
             "wgpu" => Ok(Backend::Wgpu),
+            "cuda" => Ok(Backend::Cuda),
             _ => Err(crate::Error::UnknownBackend(name.to_string())),
         }
     }
@@ -62,6 +106,7 @@ impl Backend {
     ///
     /// The CPU backends first apply the process's host-memory policy
     /// ([`host_memory::keep_freed_tensor_memory`](crate::host_memory::keep_freed_tensor_memory)).
+    /// A GPU device is made lazily: a machine without one fails at its first tensor operation.
     #[allow(unreachable_code)]
     pub fn device(self) -> crate::Result<Device> {
         match self {
@@ -84,6 +129,10 @@ impl Backend {
                 #[cfg(feature = "wgpu")]
                 return Ok(Device::wgpu(Default::default()));
             }
+            Backend::Cuda => {
+                #[cfg(feature = "cuda")]
+                return Ok(Device::cuda(0usize));
+            }
         }
         Err(crate::Error::BackendNotBuilt(self))
     }
@@ -99,15 +148,36 @@ impl Backend {
 /// # Panics
 /// If the crate was built without any CPU backend feature.
 pub fn cpu() -> Device {
-    Backend::available()
-        .into_iter()
-        .find(|b| *b != Backend::Wgpu)
-        .expect("brdf-neural built without a CPU backend (enable `flex` or `ndarray`)")
+    Backend::default()
         .device()
-        .expect("available backend")
+        .expect("brdf-neural built without a CPU backend (enable `flex` or `ndarray`)")
 }
 
 /// [`cpu`] with autodiff, for training.
 pub fn cpu_training() -> Device {
     cpu().autodiff()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_cpu_means_the_default() {
+        for b in Backend::ALL {
+            assert_eq!(Backend::parse(b.name()).unwrap(), b);
+            assert_eq!(Backend::parse(&b.name().to_uppercase()).unwrap(), b);
+        }
+        assert_eq!(Backend::parse("cpu").unwrap(), Backend::default());
+        assert!(Backend::parse("metal").is_err());
+        assert!(Backend::available().contains(&Backend::default()));
+    }
+
+    #[test]
+    fn a_backend_not_built_in_is_refused_with_its_name() {
+        for b in Backend::ALL.into_iter().filter(|b| !b.is_built()) {
+            let msg = b.device().unwrap_err().to_string();
+            assert!(msg.contains(b.name()), "{msg}");
+        }
+    }
 }

@@ -13,11 +13,13 @@ pub enum Error {
     /// A model name that is neither a configuration name nor a paper table row.
     #[error("unknown model name {0:?} (see ModelKind::ALL for the names)")]
     UnknownModel(String),
-    /// A backend name other than flex, ndarray or wgpu.
-    #[error("unknown backend {0:?} (expected flex, ndarray or wgpu)")]
+    /// A backend name other than cpu, flex, ndarray, wgpu or cuda.
+    #[error("unknown backend {0:?} (expected cpu, flex, ndarray, wgpu or cuda)")]
     UnknownBackend(String),
     /// A backend whose cargo feature is off in this build.
-    #[error("backend {0:?} is not built in: enable the cargo feature of brdf-neural")]
+    #[error(
+        "backend {0} is not built in: rebuild with `--features {0}` (e.g. `cargo build --release -p xtask --features {0}`)"
+    )]
     BackendNotBuilt(Backend),
     /// Sample arrays whose lengths disagree.
     #[error("batch shape: {0}")]

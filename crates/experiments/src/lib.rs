@@ -47,6 +47,8 @@ pub mod train;
 pub mod train_config;
 pub mod trainer;
 
+/// The burn backend a fit or an evaluation runs on (`--backend`).
+pub use brdf_neural::device::Backend;
 pub use config::{RunConfig, TrainConfig};
 pub use error::{Error, Result};
 pub use train::{FitOptions, FitOutcome, fit};

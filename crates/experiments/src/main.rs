@@ -3,6 +3,7 @@
 //! fitted material as a MERL binary.
 
 use anyhow::{Context, Result, bail};
+use brdf_neural::device::Backend;
 use clap::{Parser, Subcommand};
 use experiments::config::RunConfig;
 use experiments::eval::EnergyEstimator;
@@ -37,6 +38,10 @@ enum Command {
         /// run, else `<out>/../cache`).
         #[arg(long)]
         cache: Option<PathBuf>,
+        /// The burn backend: `cpu` (default), `wgpu` or `cuda` (GPU builds: `--features wgpu`
+        /// or `cuda`), also `flex` or `ndarray`.
+        #[arg(long, default_value = "cpu", value_parser = parse_backend)]
+        backend: Backend,
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
@@ -53,6 +58,10 @@ enum Command {
         /// run, else `<run>/../cache`).
         #[arg(long)]
         cache: Option<PathBuf>,
+        /// The burn backend: `cpu` (default), `wgpu` or `cuda` (GPU builds: `--features wgpu`
+        /// or `cuda`), also `flex` or `ndarray`.
+        #[arg(long, default_value = "cpu", value_parser = parse_backend)]
+        backend: Backend,
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
@@ -101,14 +110,20 @@ enum Command {
     },
 }
 
+/// `--backend`: a backend name (see `brdf_neural::device`).
+fn parse_backend(name: &str) -> std::result::Result<Backend, String> {
+    Backend::parse(name).map_err(|e| e.to_string())
+}
+
 fn main() -> Result<()> {
     match Cli::parse().command {
-        Command::Fit { config, scene, out, cache, quiet } => {
-            fit_command(config, scene, &out, cache, quiet)?;
+        Command::Fit { config, scene, out, cache, backend, quiet } => {
+            fit_command(config, scene, &out, cache, backend, quiet)?;
         }
-        Command::Eval { run, scene, cache, quiet } => {
-            let metrics = experiments::eval::eval(&run, scene.as_deref(), cache.as_deref(), !quiet)
-                .with_context(|| format!("eval of {}", run.display()))?;
+        Command::Eval { run, scene, cache, backend, quiet } => {
+            let metrics =
+                experiments::eval::eval(&run, scene.as_deref(), cache.as_deref(), backend, !quiet)
+                    .with_context(|| format!("eval of {}", run.display()))?;
             println!("{}", serde_json::to_string_pretty(&metrics)?);
         }
         Command::Energy { run, estimator, pairs, cache, quiet } => {
@@ -154,6 +169,7 @@ fn fit_command(
     scene: Option<PathBuf>,
     out: &Path,
     cache: Option<PathBuf>,
+    backend: Backend,
     quiet: bool,
 ) -> Result<()> {
     let stored = RunDir::new(out).config();
@@ -166,7 +182,7 @@ fn fit_command(
     if let Some(scene) = scene {
         cfg.scene = Some(std::path::absolute(&scene).unwrap_or(scene));
     }
-    let options = FitOptions { progress: !quiet, cache_dir: cache, ..Default::default() };
+    let options = FitOptions { progress: !quiet, cache_dir: cache, backend, ..Default::default() };
     match experiments::fit(&cfg, out, options)
         .with_context(|| format!("fit into {}", out.display()))?
     {

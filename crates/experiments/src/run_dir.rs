@@ -250,6 +250,9 @@ pub struct RunMetrics {
     /// before it was recorded).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub phases: Option<crate::profile::StepPhases>,
+    /// The burn backend that trained the run (absent in runs trained before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub backend: Option<brdf_neural::device::Backend>,
 }
 
 impl RunMetrics {

@@ -46,6 +46,8 @@ pub struct FitOptions {
     /// The configuration is the one just read from the run directory's own `config.toml` (a
     /// sweep's run): it is not read again to compare.
     pub config_from_run_dir: bool,
+    /// The burn backend that trains (`--backend`; default: the CPU backend).
+    pub backend: brdf_neural::device::Backend,
 }
 
 /// How [`fit`] ended.
@@ -67,8 +69,10 @@ pub enum FitOutcome {
 /// What a fit that trained to the end hands to evaluation in the same process, so that
 /// neither the weights nor the scene are read back from disk.
 pub struct Trained {
-    /// The fitted model in inference mode, on the CPU device.
+    /// The fitted model in inference mode, on `device`.
     pub model: BrdfModel,
+    /// The inference device of the backend it trained on.
+    pub device: Device,
     /// The scene it was trained on, opened and verified once.
     pub scene: SceneDataset,
 }
@@ -194,7 +198,7 @@ pub fn fit_and_keep(
     let RunData { scene, train: data, val, val_floor } = training_data(config, &cache)?;
     let t = &config.train;
 
-    let device = brdf_neural::device::cpu_training();
+    let device = options.backend.training_device()?;
     device.seed(config.seed);
     let mut model = config.model.init(&device)?;
     if t.output_init == OutputInit::Data {
@@ -222,9 +226,11 @@ pub fn fit_and_keep(
     });
     save_weights(&model, &dir.weights())?;
     let mut metrics = run_metrics(config, &state, &data, val.len());
+    metrics.backend = Some(options.backend);
     metrics.val_loss_floor = val_floor;
     metrics.write(&dir.metrics())?;
-    let trained = Trained { model: model.valid(), scene };
+    let device = lp.device.inner();
+    let trained = Trained { model: model.valid(), device, scene };
     Ok((FitOutcome::Finished { metrics, resumed_from }, Some(trained)))
 }
 
@@ -262,6 +268,7 @@ fn run_metrics(
         snapshots: state.snapshots.clone(),
         test: None,
         phases: Some(state.phases.clone()),
+        backend: None,
     }
 }
 

@@ -185,7 +185,7 @@ impl Loop<'_> {
         if self.val.is_empty() || !state.step.is_multiple_of(t.validate_every) {
             return Ok(None);
         }
-        let v = validation_loss(model, self.config, self.val)?;
+        let v = validation_loss(model, self.config, self.val, &self.device.clone().inner())?;
         match state.plateau.update(state.step, v, t) {
             Decision::Stop => state.stopped = Some(StopReason::Plateau),
             Decision::Decayed | Decision::Continue => {}
@@ -234,10 +234,14 @@ impl Loop<'_> {
 }
 
 /// The gamma-MSE of `model` on the records `val` (no regularisers), computed in inference
-/// mode on the CPU device.
-pub fn validation_loss(model: &BrdfModel, config: &RunConfig, val: &TrainingData) -> Result<f64> {
-    let device = brdf_neural::device::cpu();
-    let pred = crate::eval::predict(&model.valid(), &config.model, val, &device, false)?;
+/// mode on `device` (the inference device of the training backend).
+pub fn validation_loss(
+    model: &BrdfModel,
+    config: &RunConfig,
+    val: &TrainingData,
+    device: &Device,
+) -> Result<f64> {
+    let pred = crate::eval::predict(&model.valid(), &config.model, val, device, false)?;
     Ok(gamma_mse(val, &pred.f))
 }
 

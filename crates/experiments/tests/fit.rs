@@ -124,7 +124,7 @@ fn models_fit_the_scene_and_eval_scores_them() {
         // A finished run is reported and skipped.
         let again = fit(&config(kind, 300, eval), &run, FitOptions::default()).unwrap();
         assert!(matches!(again, FitOutcome::AlreadyFinished(_)), "{again:?}");
-        let test = experiments::eval::eval(&run, None, None, false).unwrap();
+        let test = experiments::eval::eval(&run, None, None, Default::default(), false).unwrap();
         assert!(test.images == 4 && test.psnr.is_finite() && test.psnr > 15.0, "{kind}: {test:?}");
         assert!(test.flip.is_finite() && test.dssim.is_finite(), "{kind}: {test:?}");
         assert!(test.rmse_cbrt.is_some_and(f64::is_finite) && test.rmse_samples > 0);

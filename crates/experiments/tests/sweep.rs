@@ -54,7 +54,7 @@ fn a_miniature_sweep_produces_every_table_and_resumes() {
     let tmp = test_support::TempDir::new("sweep");
     let out = tmp.0.clone();
     let profile = SweepProfile::parse(PROFILE, "mini.toml").unwrap();
-    let s = sweep::sweep(&profile, &out, &data, &Execution::InProcess).unwrap();
+    let s = sweep::sweep(&profile, &out, &data, &Execution::InProcess(Default::default())).unwrap();
     assert!(s.failed.is_empty(), "{:?}", s.failed);
     // 3 Table 1 runs (with snapshots: the run-time curve) + 2 NOL (single MLP, enhanced
     // shared).
@@ -93,7 +93,8 @@ fn a_miniature_sweep_produces_every_table_and_resumes() {
         assert!(out.join(f).is_file(), "{f} not written");
     }
     // Everything is finished: a second sweep runs nothing.
-    let again = sweep::sweep(&profile, &out, &data, &Execution::InProcess).unwrap();
+    let again =
+        sweep::sweep(&profile, &out, &data, &Execution::InProcess(Default::default())).unwrap();
     assert_eq!((again.completed, again.skipped, again.scenes_kept), (0, 5, 1));
     // A changed configuration is a new run; --emit-jobs lists exactly the unfinished one.
     let changed =
@@ -114,8 +115,13 @@ fn the_smoke_profile_runs_end_to_end() {
     let tmp = test_support::TempDir::new("smoke");
     let out = tmp.0.clone();
     let profile = SweepProfile::load("smoke").unwrap();
-    let s =
-        sweep::sweep(&profile, &out, std::path::Path::new("data"), &Execution::InProcess).unwrap();
+    let s = sweep::sweep(
+        &profile,
+        &out,
+        std::path::Path::new("data"),
+        &Execution::InProcess(Default::default()),
+    )
+    .unwrap();
     assert!(s.failed.is_empty(), "{:?}", s.failed);
     assert_eq!((s.runs.len(), s.completed), (74, 74));
     let c = sweep::collect(&[out.join("runs")], &out, "smoke").unwrap();

@@ -7,6 +7,7 @@ use crate::run_dir::RunDir;
 use crate::train::load_weights;
 use crate::{Error, Result};
 use brdf_neural::BrdfModel;
+use brdf_neural::device::Backend;
 use burn::tensor::Device;
 use scene::Split;
 use scene::{SampleSet, SceneDataset};
@@ -27,8 +28,19 @@ pub struct FittedRun {
 }
 
 impl FittedRun {
-    /// Opens `run`; `scene` overrides the configured scene directory, `cache` the cache.
+    /// Opens `run` on the default CPU backend; `scene` overrides the configured scene
+    /// directory, `cache` the cache.
     pub fn open(run: &Path, scene: Option<&Path>, cache: Option<&Path>) -> Result<Self> {
+        Self::open_on(run, scene, cache, Backend::default())
+    }
+
+    /// [`FittedRun::open`] with the model on `backend`'s device.
+    pub fn open_on(
+        run: &Path,
+        scene: Option<&Path>,
+        cache: Option<&Path>,
+        backend: Backend,
+    ) -> Result<Self> {
         let run = RunDir::new(run);
         let mut config = run.read_config()?;
         if let Some(s) = scene {
@@ -38,7 +50,7 @@ impl FittedRun {
             .scene
             .clone()
             .ok_or_else(|| Error::config("scene", "no scene directory (pass --scene)"))?;
-        let device = brdf_neural::device::cpu();
+        let device = backend.device()?;
         let model = load_weights(&config, &run, &device)?;
         let dataset = SceneDataset::open(&scene_dir)?;
         let cache = run.cache(&config, cache);
@@ -48,8 +60,8 @@ impl FittedRun {
     /// The run that was just trained in this process, from what training hands over (no
     /// weights or scene read back from disk).
     pub fn from_trained(config: RunConfig, trained: crate::train::Trained, cache: PathBuf) -> Self {
-        let device = brdf_neural::device::cpu();
-        Self { config, device, model: trained.model, dataset: trained.scene, cache }
+        let crate::train::Trained { model, device, scene } = trained;
+        Self { config, device, model, dataset: scene, cache }
     }
 
     /// Another weight file of the same configuration (a snapshot) on the run's device.

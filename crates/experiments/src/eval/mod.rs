@@ -187,10 +187,11 @@ pub fn eval(
     run: &Path,
     scene: Option<&Path>,
     cache: Option<&Path>,
+    backend: brdf_neural::device::Backend,
     progress: bool,
 ) -> Result<TestMetrics> {
     let start = Instant::now();
-    let fitted = FittedRun::open(run, scene, cache)?;
+    let fitted = FittedRun::open_on(run, scene, cache, backend)?;
     eval_fitted(&fitted, run, progress, start)
 }
 

@@ -14,6 +14,7 @@ use crate::eval::fitted::FittedRun;
 use crate::run_dir::{RunDir, SweepLayout};
 use crate::train::fit_and_keep;
 use crate::{Error, FitOptions, FitOutcome, Result};
+use brdf_neural::device::Backend;
 use dataset_merl::generate_scene;
 use scene::SceneDataset;
 use scene::{MaterialSpec, SceneConfig, SceneSettings};
@@ -24,9 +25,10 @@ use std::time::Instant;
 /// How runs are executed.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Execution {
-    /// One after the other in this process, with progress bars.
-    InProcess,
-    /// `jobs` child processes at a time, each `<program> <args...> <run dir>`.
+    /// One after the other in this process, with progress bars, on this backend.
+    InProcess(Backend),
+    /// `jobs` child processes at a time, each `<program> <args...> <run dir>` (the arguments
+    /// carry the backend, e.g. `run-one --backend wgpu`).
     Children {
         /// Concurrent children.
         jobs: usize,
@@ -69,8 +71,9 @@ pub fn is_done(run: &Path) -> bool {
 }
 
 /// Fits (resuming) and evaluates one prepared run directory. The configuration is read once;
-/// a run trained here is evaluated with the model and scene training hands over.
-pub fn run_one(run: &Path, progress: bool) -> Result<()> {
+/// a run trained here is evaluated with the model and scene training hands over, on the
+/// backend it trained on.
+pub fn run_one(run: &Path, progress: bool, backend: Backend) -> Result<()> {
     if is_done(run) {
         return Ok(());
     }
@@ -81,6 +84,7 @@ pub fn run_one(run: &Path, progress: bool) -> Result<()> {
         progress,
         cache_dir: Some(cache.clone()),
         config_from_run_dir: true,
+        backend,
         ..Default::default()
     };
     let fitted = match fit_and_keep(&config, run, options)? {
@@ -88,7 +92,7 @@ pub fn run_one(run: &Path, progress: bool) -> Result<()> {
             return Err(Error::format(run, format!("training stopped at step {step}")));
         }
         (_, Some(trained)) => FittedRun::from_trained(config, trained, cache),
-        (_, None) => FittedRun::open(run, None, Some(&cache))?,
+        (_, None) => FittedRun::open_on(run, None, Some(&cache), backend)?,
     };
     crate::eval::eval_fitted(&fitted, run, progress, Instant::now())?;
     Ok(())
@@ -197,10 +201,10 @@ pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) ->
     summary.skipped = dirs.len() - todo.len();
     let bar = stdx::progress::bar(todo.len() as u64, "runs", "sweep", true);
     match how {
-        Execution::InProcess => {
+        Execution::InProcess(backend) => {
             for d in &todo {
                 bar.set_message(short(d));
-                match bar.suspend(|| run_one(d, true)) {
+                match bar.suspend(|| run_one(d, true, *backend)) {
                     Ok(()) => summary.completed += 1,
                     Err(e) => summary.failed.push(((*d).clone(), e.to_string())),
                 }

@@ -244,6 +244,11 @@ mod tests {
         assert_eq!(curve.len(), 9);
         assert!(curve.iter().all(|r| r.scene == 0 && r.config.train.snapshots));
         assert!(curve.iter().all(|r| r.purposes.contains(&Purpose::Table)));
+        // The paper's scale (docs/reproduce.md sizes its cost from this count): 25 scenes
+        // (materials zipped with the 9 meshes), each with the smoke profile's 37 runs.
+        let full = SweepProfile::load("full").unwrap();
+        assert_eq!(scenes(&full).len(), 25);
+        assert_eq!(runs(&full).unwrap().len(), 25 * (9 + 5 + 10 + 5 + 8));
         let runtime = SweepProfile::load("runtime").unwrap();
         let rt = runs(&runtime).unwrap();
         assert_eq!(rt.len(), 9);
