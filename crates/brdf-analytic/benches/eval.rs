@@ -4,6 +4,8 @@
 //! Run: `cargo bench -p brdf-analytic --bench eval`. Criterion prints "thrpt" in elements/s,
 //! one element being one BRDF evaluation (RGB).
 
+mod common;
+
 use brdf_analytic::albedo::cosine_sample;
 use brdf_analytic::*;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
@@ -18,19 +20,7 @@ fn directions(seed: u64) -> Vec<[f32; 3]> {
 }
 
 fn models() -> Vec<(&'static str, Box<dyn Brdf<f32>>)> {
-    let all_lobes = DisneyParams {
-        base_color: [0.6, 0.3, 0.2],
-        metallic: 0.3,
-        subsurface: 0.5,
-        specular: 0.7,
-        roughness: 0.35,
-        specular_tint: 0.4,
-        sheen: 0.6,
-        sheen_tint: 0.5,
-        clearcoat: 0.8,
-        clearcoat_gloss: 0.7,
-        gamma_base_color: true,
-    };
+    let all_lobes = common::disney_all_lobes();
     vec![
         ("lambert", Box::new(Lambert::new(LambertParams::default()))),
         ("realistic-phong", Box::new(RealisticPhong::new(RealisticPhongParams::default()))),

@@ -1,10 +1,15 @@
 //! The isotropic Disney principled BRDF (Burley 2012), every lobe.
 
-use crate::brdf::{Brdf, Rgb};
+use crate::brdf::{Brdf, BrdfSample, Rgb};
 use crate::microfacet::{
     PairGeometry, alpha_from_roughness, ggx_d, schlick_weight, smith_ggx_visibility,
 };
 use crate::params::{ParamError, check, check_rgb, clamp_or, clamp_rgb};
+use crate::sampling::{
+    above_horizon, clamp_uniform, cosine_hemisphere, cosine_pdf, finish, ggx_reflection_pdf,
+    ggx_visible_normal, gtr1_normal, gtr1_normal_pdf, lobe_probabilities, mean3, pick_lobe,
+    reflect,
+};
 use angles::{Real, Vec3};
 
 /// Parameters of [`Disney`], all in [0, 1], with the reference shader's defaults.
@@ -25,6 +30,15 @@ use angles::{Real, Vec3};
 /// `anisotropic` is fixed to 0 ([P supp. "Disney BRDF"]). The paper's network predicts the 13
 /// values by sigmoid, roughness as sigmoid(0.5 z). `gamma_base_color` (default false, the
 /// project's decision) applies the reference shader's `mon2lin` (c^2.2) to the base colour.
+///
+/// Sampling: a one-sample mixture (balance heuristic) of three samplers: the cosine-weighted
+/// hemisphere (diffuse, subsurface and sheen), GGX visible normals reflected about the sampled
+/// normal (specular, Heitz 2018) and GTR1 normals drawn with density D cos and reflected
+/// (clear coat, only when `clearcoat` > 0). The lobes are picked with probabilities from
+/// estimates of their albedo at the view angle (diffuse: mean(Cdlin)(1 - metallic) plus
+/// 0.1 mean(Csheen) sheen (1 - metallic); specular: mean of Fs at l.h = n.v; clear coat:
+/// 0.25 clearcoat Fr at n.v), each at least 5 %; pdf = the mixture density. A reflected
+/// direction below the horizon is no sample (`None`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DisneyParams<T> {
     /// Base colour, RGB.
@@ -171,6 +185,37 @@ impl<T: Real> Disney<T> {
     pub fn params(&self) -> &DisneyParams<T> {
         &self.params
     }
+
+    /// Probabilities of picking the diffuse, specular and clear-coat samplers for n.v = `nv`
+    /// (the last is 0 without a clear coat).
+    #[inline]
+    fn lobe_probabilities(&self, nv: T) -> [T; 3] {
+        let one = T::one();
+        let w = schlick_weight(nv);
+        let diffuse = mean3(self.diffuse) * T::PI() + T::lit(0.1) * mean3(self.sheen);
+        let specular = mean3(self.cspec0.map(|c| c + (one - c) * w));
+        if self.cc_scale != T::zero() {
+            let clearcoat =
+                T::lit(0.25) * self.params.clearcoat * (T::lit(0.04) + T::lit(0.96) * w);
+            lobe_probabilities([diffuse, specular, clearcoat])
+        } else {
+            let [d, s] = lobe_probabilities([diffuse, specular]);
+            [d, s, T::zero()]
+        }
+    }
+
+    /// The mixture density of l for v (both above the horizon).
+    #[inline]
+    fn mixture_pdf(&self, v: Vec3<T>, l: Vec3<T>) -> T {
+        let Some(g) = PairGeometry::of(l, v) else { return T::zero() };
+        let p = self.lobe_probabilities(g.nv);
+        let mut pdf =
+            p[0] * cosine_pdf(g.nl) + p[1] * ggx_reflection_pdf(g.nv, g.sin2_h, self.alpha);
+        if p[2] > T::zero() && g.lh > T::zero() {
+            pdf = pdf + p[2] * gtr1_normal_pdf(g.sin2_h, self.cc_a2) / (T::lit(4.0) * g.lh);
+        }
+        pdf
+    }
 }
 
 impl<T: Real> Brdf<T> for Disney<T> {
@@ -212,5 +257,24 @@ impl<T: Real> Brdf<T> for Disney<T> {
 
     fn name(&self) -> &'static str {
         "Disney"
+    }
+
+    /// Mixture of the cosine hemisphere, GGX visible-normal reflection and GTR1 reflection.
+    fn sample(&self, v: Vec3<T>, u: [T; 2]) -> Option<BrdfSample<T>> {
+        if !above_horizon(v) {
+            return None;
+        }
+        let (k, u0) = pick_lobe(self.lobe_probabilities(v[2].min(T::one())), clamp_uniform(u[0]));
+        let u = [u0, clamp_uniform(u[1])];
+        let l = match k {
+            0 => cosine_hemisphere(u),
+            1 => reflect(v, ggx_visible_normal(v, self.alpha, u)),
+            _ => reflect(v, gtr1_normal(self.cc_a2, u)),
+        };
+        finish(self, v, l, self.mixture_pdf(v, l))
+    }
+
+    fn pdf(&self, v: Vec3<T>, l: Vec3<T>) -> T {
+        self.mixture_pdf(v, l)
     }
 }

@@ -1,7 +1,8 @@
 //! Lambertian reflectance.
 
-use crate::brdf::{Brdf, Rgb};
+use crate::brdf::{Brdf, BrdfSample, Rgb};
 use crate::params::{ParamError, check_rgb, clamp_rgb};
+use crate::sampling::{above_horizon, clamp_uniform, cosine_hemisphere, cosine_pdf};
 use angles::{Real, Vec3};
 
 /// Parameters of [`Lambert`].
@@ -9,6 +10,9 @@ use angles::{Real, Vec3};
 /// | parameter | range | unit | default |
 /// | --- | --- | --- | --- |
 /// | `albedo` | [0, 1]^3 | - | 0.5 |
+///
+/// Sampling: exact. l is drawn from the cosine-weighted hemisphere, whose density cos / pi is
+/// proportional to f cos, so every sample's weight is the albedo.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LambertParams<T> {
     /// Diffuse albedo rho, linear RGB.
@@ -57,6 +61,20 @@ impl<T: Real> Brdf<T> for Lambert<T> {
 
     fn name(&self) -> &'static str {
         "Lambert"
+    }
+
+    /// Cosine-weighted l; weight = albedo exactly.
+    fn sample(&self, v: Vec3<T>, u: [T; 2]) -> Option<BrdfSample<T>> {
+        if !above_horizon(v) {
+            return None;
+        }
+        let l = cosine_hemisphere(u.map(clamp_uniform));
+        let pdf = cosine_pdf(l[2]);
+        (pdf > T::zero()).then_some(BrdfSample { l, weight: self.params.albedo, pdf })
+    }
+
+    fn pdf(&self, v: Vec3<T>, l: Vec3<T>) -> T {
+        if l[2] > T::zero() && v[2] > T::zero() { cosine_pdf(l[2]) } else { T::zero() }
     }
 }
 

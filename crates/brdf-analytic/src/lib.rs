@@ -7,6 +7,12 @@
 //! surface) and returns f_r in 1/sr as linear RGB, without the cosine factor. Shared physics
 //! (Fresnel terms, the GGX distribution and Smith visibility) lives in [`microfacet`].
 //!
+//! Every model also samples: [`Brdf::sample`] draws a light direction l for a view direction v
+//! and returns it with its density and the weight f cos / pdf ([`BrdfSample`]), and
+//! [`Brdf::pdf`] gives that density for any pair. The shared samplers (cosine hemisphere, GGX
+//! visible normals, Phong and GTR1 lobes) and the lobe mixture live in [`sampling`]; each model's
+//! parameter table says which strategy it uses.
+//!
 //! Conventions every model keeps (architecture invariants):
 //! * evaluating never fails, never allocates and never returns NaN or Inf: outside the upper
 //!   hemisphere (n.l <= 0 or n.v <= 0) it returns 0, and parameters are validated or clamped
@@ -28,6 +34,28 @@
 //! // Below the horizon the BRDF is zero.
 //! assert_eq!(brdf.eval([s, 0.0, -c], [0.0, 0.0, 1.0]), [0.0; 3]);
 //! ```
+//!
+//! Importance sampling, here a Monte Carlo estimate of the directional albedo for a viewer at
+//! 45 degrees (the uniforms would come from the renderer's sampler):
+//!
+//! ```
+//! use brdf_analytic::{Brdf, TorranceSparrow, TorranceSparrowParams};
+//! let brdf = TorranceSparrow::new(TorranceSparrowParams { roughness: 0.3, ..Default::default() });
+//! let v = [0.5f32.sqrt(), 0.0, 0.5f32.sqrt()];
+//! let n = 64;
+//! let mut albedo = [0.0f32; 3];
+//! for i in 0..n {
+//!     for j in 0..n {
+//!         let u = [(i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32];
+//!         // None: the sampled direction fell below the horizon; it contributes 0.
+//!         if let Some(s) = brdf.sample(v, u) {
+//!             assert!(s.l[2] > 0.0 && s.pdf == brdf.pdf(v, s.l));
+//!             (0..3).for_each(|c| albedo[c] += s.weight[c] / (n * n) as f32);
+//!         }
+//!     }
+//! }
+//! assert!(albedo.iter().all(|a| *a > 0.3 && *a < 1.0), "{albedo:?}");
+//! ```
 
 pub mod albedo;
 mod batch;
@@ -39,13 +67,14 @@ pub mod microfacet;
 mod params;
 mod phong;
 pub mod quadrature;
+pub mod sampling;
 mod torrance_sparrow;
 
 pub use angles::{Real, Vec3};
 pub use batch::eval_batch;
 #[cfg(feature = "rayon")]
 pub use batch::par_eval_batch;
-pub use brdf::{Brdf, Rgb};
+pub use brdf::{Brdf, BrdfSample, Rgb};
 pub use disney::{Disney, DisneyParams};
 /// FMBRDF's frame helpers, shared with its tensor twin: the body network's input features
 /// (view-aligned frame of the addendum) and the clamped tan(theta) of the Smith network.

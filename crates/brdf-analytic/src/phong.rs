@@ -1,7 +1,11 @@
 //! Realistic Phong: the energy-conserving modified Phong model of Lafortune and Willems (1994).
 
-use crate::brdf::{Brdf, Rgb};
+use crate::brdf::{Brdf, BrdfSample, Rgb};
 use crate::params::{ParamError, check, check_rgb, clamp_or, clamp_rgb};
+use crate::sampling::{
+    above_horizon, clamp_uniform, cosine_hemisphere, cosine_pdf, finish, lobe_probabilities, mean3,
+    phong_lobe, phong_lobe_pdf, pick_lobe,
+};
 use angles::{Real, Vec3};
 
 /// Parameters of [`RealisticPhong`].
@@ -14,6 +18,11 @@ use angles::{Real, Vec3};
 ///
 /// The paper's network predicts k = sigmoid(.) and a split zeta = sigmoid(.) with kd = zeta k and
 /// ks = (1 - zeta) k ([`RealisticPhongParams::from_split`]), and N = 1 + softplus(.).
+///
+/// Sampling: a one-sample mixture (balance heuristic) of the cosine-weighted hemisphere
+/// (diffuse) and the lobe (N + 1)/(2 pi) cos^N about the mirror direction of v (specular), picked
+/// with probabilities from mean(kd) and mean(ks) (each at least 5 %); pdf = the mixture density.
+/// A lobe direction below the horizon is no sample (`None`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RealisticPhongParams<T> {
     /// Diffuse coefficient, linear RGB.
@@ -97,6 +106,20 @@ impl<T: Real> RealisticPhong<T> {
     pub fn params(&self) -> &RealisticPhongParams<T> {
         &self.params
     }
+
+    /// Probabilities of picking the diffuse and the lobe sampler.
+    #[inline]
+    fn lobe_probabilities(&self) -> [T; 2] {
+        lobe_probabilities([mean3(self.params.kd), mean3(self.params.ks)])
+    }
+
+    /// The mixture density for v, l above the horizon and the probabilities `p`.
+    #[inline]
+    fn mixture_pdf(&self, v: Vec3<T>, l: Vec3<T>, p: [T; 2]) -> T {
+        // r.v = l.r_v with r_v the mirror direction of v, computed as in `eval`.
+        let rv = l[2] * v[2] - (l[0] * v[0] + l[1] * v[1]);
+        p[0] * cosine_pdf(l[2]) + p[1] * phong_lobe_pdf(rv, self.params.exponent)
+    }
 }
 
 impl<T: Real> Brdf<T> for RealisticPhong<T> {
@@ -114,6 +137,33 @@ impl<T: Real> Brdf<T> for RealisticPhong<T> {
 
     fn name(&self) -> &'static str {
         "RP"
+    }
+
+    /// Mixture of the cosine hemisphere and the cos^N lobe about the mirror direction of v.
+    fn sample(&self, v: Vec3<T>, u: [T; 2]) -> Option<BrdfSample<T>> {
+        if !above_horizon(v) {
+            return None;
+        }
+        let p = self.lobe_probabilities();
+        let (k, u0) = pick_lobe(p, clamp_uniform(u[0]));
+        let u = [u0, clamp_uniform(u[1])];
+        let l = if k == 0 {
+            cosine_hemisphere(u)
+        } else {
+            phong_lobe([-v[0], -v[1], v[2]], self.params.exponent, u)
+        };
+        if !above_horizon(l) {
+            return None;
+        }
+        finish(self, v, l, self.mixture_pdf(v, l, p))
+    }
+
+    fn pdf(&self, v: Vec3<T>, l: Vec3<T>) -> T {
+        if l[2] > T::zero() && v[2] > T::zero() {
+            self.mixture_pdf(v, l, self.lobe_probabilities())
+        } else {
+            T::zero()
+        }
     }
 }
 

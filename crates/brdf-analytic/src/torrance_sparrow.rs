@@ -1,10 +1,13 @@
 //! Torrance-Sparrow microfacet model with GGX, Smith-GGX and Schlick, plus a (1 - F) diffuse term.
 
-use crate::brdf::{Brdf, Rgb};
+use crate::brdf::{Brdf, BrdfSample, Rgb};
 use crate::microfacet::{
     PairGeometry, alpha_from_roughness, ggx_d, schlick_weight, smith_ggx_visibility,
 };
 use crate::params::{ParamError, check, check_rgb, clamp_or, clamp_rgb};
+use crate::sampling::{
+    cosine_pdf, ggx_reflection_pdf, lobe_probabilities, mean3, sample_cosine_or_ggx,
+};
 use angles::{Real, Vec3};
 
 /// Parameters of [`TorranceSparrow`].
@@ -16,6 +19,12 @@ use angles::{Real, Vec3};
 /// | `f0` | [0, 1]^3 | - | 0.04 |
 ///
 /// The paper's network predicts 7 values: roughness = sigmoid(0.5 z), diffuse and f0 by sigmoid.
+///
+/// Sampling: a one-sample mixture (balance heuristic) of the cosine-weighted hemisphere
+/// (diffuse) and GGX visible normals reflected about the sampled normal (specular, Heitz 2018),
+/// picked with probabilities from the Schlick reflectance at the view angle, F(n.v), against
+/// rho_d (1 - F(n.v)) (each at least 5 %); pdf = the mixture density. A reflected direction
+/// below the horizon is no sample (`None`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TorranceSparrowParams<T> {
     /// Perceptual roughness r; alpha = r^2.
@@ -76,6 +85,24 @@ impl<T: Real> TorranceSparrow<T> {
     pub fn params(&self) -> &TorranceSparrowParams<T> {
         &self.params
     }
+
+    /// Probabilities of picking the diffuse and the specular sampler for n.v = `nv`.
+    #[inline]
+    fn lobe_probabilities(&self, nv: T) -> [T; 2] {
+        let w = schlick_weight(nv);
+        let p = &self.params;
+        let f = p.f0.map(|f0| f0 + (T::one() - f0) * w);
+        let diffuse = [0, 1, 2].map(|c| p.diffuse[c] * (T::one() - f[c]));
+        lobe_probabilities([mean3(diffuse), mean3(f)])
+    }
+
+    /// The mixture density of l for v (both above the horizon).
+    #[inline]
+    fn mixture_pdf(&self, v: Vec3<T>, l: Vec3<T>) -> T {
+        let Some(g) = PairGeometry::of(l, v) else { return T::zero() };
+        let p = self.lobe_probabilities(g.nv);
+        p[0] * cosine_pdf(g.nl) + p[1] * ggx_reflection_pdf(g.nv, g.sin2_h, self.alpha)
+    }
 }
 
 impl<T: Real> Brdf<T> for TorranceSparrow<T> {
@@ -96,5 +123,15 @@ impl<T: Real> Brdf<T> for TorranceSparrow<T> {
 
     fn name(&self) -> &'static str {
         "TS"
+    }
+
+    /// Mixture of the cosine hemisphere and GGX visible-normal reflection.
+    fn sample(&self, v: Vec3<T>, u: [T; 2]) -> Option<BrdfSample<T>> {
+        let probabilities = |nv| self.lobe_probabilities(nv);
+        sample_cosine_or_ggx(self, v, u, probabilities, self.alpha, |l| self.mixture_pdf(v, l))
+    }
+
+    fn pdf(&self, v: Vec3<T>, l: Vec3<T>) -> T {
+        self.mixture_pdf(v, l)
     }
 }

@@ -2,6 +2,7 @@
 //! independent f64 evaluation of the spec's formulas, f32 against f64, finiteness under stress,
 //! reciprocity and energy measurements, parameter validation.
 
+mod common;
 #[path = "fmbrdf/reference.rs"]
 mod reference;
 #[path = "fmbrdf/util.rs"]

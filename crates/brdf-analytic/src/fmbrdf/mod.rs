@@ -5,8 +5,12 @@ mod network;
 pub(crate) mod quadrature;
 mod weights;
 
-use crate::brdf::{Brdf, Rgb};
+use crate::brdf::{Brdf, BrdfSample, Rgb};
+use crate::microfacet::{ALPHA_MIN, PairGeometry};
 use crate::params::{ParamError, check, check_rgb, clamp_or, clamp_rgb};
+use crate::sampling::{
+    cosine_pdf, ggx_reflection_pdf, lobe_probabilities, mean3, sample_cosine_or_ggx,
+};
 use angles::vec3::try_normalize;
 use angles::{Real, Vec3};
 use geometry::{COS_EPS, DEN_EPS, body_features, fresnel, smith_tan};
@@ -47,6 +51,15 @@ const KAPPA: (f64, f64, f64) = (0.0, 100.0, 0.0);
 ///   fitted k_s well above 1 is legitimate (a bright specular on a low-index material needs
 ///   k_s ~ 1/F0 = 25 at eta = 1.5); 100 leaves room for that while keeping every value finite
 ///   in f32 (see [`Fmbrdf`], "Numerics").
+///
+/// Sampling: not exact (B is a network and the generalized Gaussian has no closed-form inverse).
+/// A one-sample mixture (balance heuristic) of the cosine-weighted hemisphere (body) and GGX
+/// visible normals reflected about the sampled normal (specular), picked with probabilities
+/// from 0.8 mean(rho) (the body's albedo scale) against k_s F(n.v; eta), each at least 5 %;
+/// pdf = the mixture density. The GGX proxy takes alpha = the width alpha clamped into
+/// [0.001, 1]: the same angular scale (not the same shape: GGX's tails are heavier, which keeps
+/// the weights bounded), and for widths far above 1 rad, where the generalized Gaussian is nearly
+/// flat, GGX at alpha = 1 is flat too (D = 1/pi). The weight f cos / pdf carries the mismatch.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FmbrdfParams<T> {
     /// Refractive index eta of the dielectric (relative to the outside medium).
@@ -232,6 +245,29 @@ impl<T: Real> Fmbrdf<T> {
         weights::weights().raw.iter().map(|(n, s, v)| (*n, *s, v.as_slice()))
     }
 
+    /// The GGX alpha of the specular sampler: the width alpha clamped into [0.001, 1].
+    #[inline]
+    fn sampling_alpha(&self) -> T {
+        self.params.alpha.max(T::lit(ALPHA_MIN)).min(T::one())
+    }
+
+    /// Probabilities of picking the body (cosine) and the specular (GGX) sampler for n.v = `nv`.
+    #[inline]
+    fn lobe_probabilities(&self, nv: T) -> [T; 2] {
+        let p = &self.params;
+        let body = T::lit(0.8) * mean3(p.rho);
+        let specular = p.k_s * fresnel(nv, p.eta);
+        lobe_probabilities([body, specular])
+    }
+
+    /// The mixture density of l for v (both above the horizon).
+    #[inline]
+    fn mixture_pdf(&self, v: Vec3<T>, l: Vec3<T>) -> T {
+        let Some(g) = PairGeometry::of(l, v) else { return T::zero() };
+        let p = self.lobe_probabilities(g.nv);
+        p[0] * cosine_pdf(g.nl) + p[1] * ggx_reflection_pdf(g.nv, g.sin2_h, self.sampling_alpha())
+    }
+
     /// The two terms before the final scaling, for one unit pair with l.z, v.z > 0:
     /// (G / (n.l + eps), I_s, I_b).
     #[inline]
@@ -304,6 +340,19 @@ impl<T: Real> Brdf<T> for Fmbrdf<T> {
 
     fn is_reciprocal(&self) -> bool {
         false
+    }
+
+    /// Mixture of the cosine hemisphere and GGX visible-normal reflection (see
+    /// [`FmbrdfParams`], "Sampling").
+    fn sample(&self, v: Vec3<T>, u: [T; 2]) -> Option<BrdfSample<T>> {
+        let probabilities = |nv| self.lobe_probabilities(nv);
+        sample_cosine_or_ggx(self, v, u, probabilities, self.sampling_alpha(), |l| {
+            self.mixture_pdf(v, l)
+        })
+    }
+
+    fn pdf(&self, v: Vec3<T>, l: Vec3<T>) -> T {
+        self.mixture_pdf(v, l)
     }
 }
 

@@ -1,6 +1,9 @@
 //! Shared helpers of the brdf-analytic integration tests: parameter strategies, direction
-//! generators and the float comparison.
+//! generators, the float comparison, a scoped-thread parallel map, and (in [`chi2`]) the chi^2
+//! test of a sampler against its density.
 #![allow(dead_code)]
+
+pub mod chi2;
 
 use brdf_analytic::*;
 use proptest::prelude::*;
@@ -14,6 +17,23 @@ pub fn rel_diff(a: f64, b: f64, floor: f64) -> f64 {
 /// Largest [`rel_diff`] over the three channels.
 pub fn rel_diff_rgb(a: [f64; 3], b: [f64; 3], floor: f64) -> f64 {
     (0..3).map(|c| rel_diff(a[c], b[c], floor)).fold(0.0, f64::max)
+}
+
+/// Maps `f` over `items` on all available cores (scoped threads), keeping the order.
+pub fn par_map<I: Sync, O: Send>(items: &[I], f: impl Fn(&I) -> O + Sync) -> Vec<O> {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let chunk = items.len().div_ceil(threads).max(1);
+    std::thread::scope(|s| {
+        let handles: Vec<_> =
+            items.chunks(chunk).map(|c| s.spawn(|| c.iter().map(&f).collect::<Vec<_>>())).collect();
+        handles.into_iter().flat_map(|h| h.join().expect("worker panicked")).collect()
+    })
+}
+
+/// The unit direction at polar angle `theta_deg` from the normal, in the x-z plane (phi = 0).
+pub fn dir_deg(theta_deg: f64) -> [f64; 3] {
+    let t = theta_deg.to_radians();
+    [t.sin(), 0.0, t.cos()]
 }
 
 /// A uniformly random direction in the open upper hemisphere.

@@ -7,16 +7,7 @@ use std::f64::consts::TAU;
 /// The workspace's seeded SplitMix64 generator (`next_f64` is uniform in [0, 1)).
 pub use stdx::rng::SplitMix64 as Rng;
 
-/// Maps `f` over `items` on all available cores (scoped threads), keeping the order.
-pub fn par_map<I: Sync, O: Send>(items: &[I], f: impl Fn(&I) -> O + Sync) -> Vec<O> {
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let chunk = items.len().div_ceil(threads).max(1);
-    std::thread::scope(|s| {
-        let handles: Vec<_> =
-            items.chunks(chunk).map(|c| s.spawn(|| c.iter().map(&f).collect::<Vec<_>>())).collect();
-        handles.into_iter().flat_map(|h| h.join().expect("worker panicked")).collect()
-    })
-}
+pub use crate::common::par_map;
 
 /// Uniform direction on the upper hemisphere (uniform in solid angle).
 pub fn hemisphere(rng: &mut Rng) -> [f64; 3] {
