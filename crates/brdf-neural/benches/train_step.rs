@@ -13,7 +13,10 @@
 //! - `BRDF_BENCH_PYTORCH=python3` (a Python with torch) also runs `benches/pytorch_step.py`,
 //!   the same Single MLP step in PyTorch on the same number of threads, back to back with
 //!   ours: three rounds of 10 steps each side after warm-up, and prints the ratios;
-//! - `BRDF_KEEP_MALLOC=0` turns the host-memory policy off (`brdf_neural::host_memory`).
+//! - `BRDF_KEEP_MALLOC=0` turns the host-memory policy off (`brdf_neural::host_memory`);
+//! - `BRDF_BENCH_PRECISION=f32,bf16` (default `f32`) also times every step with bf16 matrix
+//!   products ([`brdf_neural::precision`], flex only), with the PyTorch comparison under bf16
+//!   autocast, and the flex products themselves in both precisions.
 //!
 //! Criterion's filter (e.g. `-- single_mlp`) selects the criterion groups only; the summary
 //! always times every model: median step time of 7, samples/s, and the achieved GFLOP/s
@@ -39,6 +42,7 @@
 
 use brdf_neural::device::Backend;
 use brdf_neural::mlp::MlpConfig;
+use brdf_neural::precision::MatmulPrecision;
 use brdf_neural::{BrdfBatch, BrdfModel, ModelConfig, ModelKind, Reciprocity, Samples};
 use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
 use burn::tensor::{Device, Distribution, Tensor};
@@ -93,10 +97,13 @@ struct Step {
     weight: Tensor<2>,
     target: Tensor<2>,
     device: Device,
+    backend: Backend,
+    precision: MatmulPrecision,
 }
 
 impl Step {
-    fn new(c: &ModelConfig, device: &Device, n: usize) -> Self {
+    fn new(c: &ModelConfig, backend: Backend, precision: MatmulPrecision, n: usize) -> Self {
+        let device = &backend.training_device().expect("backend built");
         device.seed(1);
         let mut state = 0x2545_f491_4f6c_dd1d_u64;
         let mut uniform = move || {
@@ -124,11 +131,14 @@ impl Step {
             weight,
             target,
             device: device.clone(),
+            backend,
+            precision,
         }
     }
 
     /// Forward, radiance L = f * (E shadow cos), MSE, backward, Adam; waits for the device.
     fn run(&mut self) {
+        let _precision = self.precision.scope(self.backend).expect("precision on this backend");
         let model = self.model.take().expect("model");
         let out = model.forward(&self.batch);
         let loss = (out.f * self.weight.clone() - self.target.clone()).square().mean();
@@ -259,12 +269,13 @@ fn median_step(step: &mut Step, reps: usize) -> f64 {
 }
 
 /// Median step time (seconds) of `benches/pytorch_step.py` run by `python`, or why not.
-fn pytorch_step(python: &str, n: usize, reps: usize) -> Result<f64, String> {
+fn pytorch_step(python: &str, n: usize, reps: usize, bf16: bool) -> Result<f64, String> {
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../../benches/pytorch_step.py");
     let threads = rayon_threads().to_string();
     let out = std::process::Command::new(python)
         .args([script, "--batch", &n.to_string(), "--threads", &threads])
         .args(["--reps", &reps.to_string(), "--machine"])
+        .args(if bf16 { &["--bf16"][..] } else { &[] })
         .output()
         .map_err(|e| format!("{python}: {e}"))?;
     let text = String::from_utf8_lossy(&out.stdout);
@@ -280,29 +291,31 @@ fn bench(cr: &mut Criterion) {
     let quick = std::env::var("BRDF_BENCH_QUICK").is_ok_and(|v| v != "0");
     let mut summary = Vec::new();
     let mut versus_pytorch = Vec::new();
-    for backend in backends() {
-        let device = backend.training_device().expect("backend built");
-        let mut group = cr.benchmark_group(format!("train_step_{backend:?}").to_lowercase());
+    for (backend, precision) in backends_and_precisions() {
+        let label = format!("train_step_{backend:?}_{}", precision.name()).to_lowercase();
+        let mut group = cr.benchmark_group(label);
         group.sample_size(10).measurement_time(Duration::from_secs(20));
         for (name, c) in configs() {
-            let mut step = Step::new(&c, &device, n);
+            let mut step = Step::new(&c, backend, precision, n);
             step.run();
             if !quick {
                 group.bench_function(name, |b| b.iter(|| step.run()));
             }
             // A direct timing for the summary (criterion's estimate is in its report).
             let secs = median_step(&mut step, 7);
-            summary.push((backend, name, secs, step_flops(&c, n) / secs / 1e9));
+            summary.push((backend, precision, name, secs, step_flops(&c, n) / secs / 1e9));
             if name == "single_mlp"
                 && let Ok(python) = std::env::var("BRDF_BENCH_PYTORCH")
             {
                 // Back to back, three rounds: ours then PyTorch's, medians of 10 steps each.
-                // Each side warms up first (PyTorch's script runs 3 untimed steps).
+                // Each side warms up first (PyTorch's script runs 3 untimed steps); bf16 is
+                // compared with PyTorch's bf16 autocast.
+                let bf16 = precision == MatmulPrecision::Bf16;
                 for _ in 0..3 {
                     median_step(&mut step, 3);
                     let ours = median_step(&mut step, 10);
-                    match pytorch_step(&python, n, 10) {
-                        Ok(theirs) => versus_pytorch.push((backend, ours, theirs)),
+                    match pytorch_step(&python, n, 10, bf16) {
+                        Ok(theirs) => versus_pytorch.push((backend, precision, ours, theirs)),
                         Err(e) => {
                             eprintln!("PyTorch baseline not run: {e}");
                             break;
@@ -327,24 +340,97 @@ fn bench(cr: &mut Criterion) {
          {:.1} GFLOP/s (split over the batch, one thread a half: {:.1} GFLOP/s)",
         rates.forward, rates.weight_grad, rates.weight_grad_split
     );
-    println!("| backend | model | step ms | samples/s | GFLOP/s | fraction of 2048^3 gemm |");
-    println!("| --- | --- | ---: | ---: | ---: | ---: |");
-    for (b, name, secs, gf) in summary {
+    if precisions().contains(&MatmulPrecision::Bf16) {
+        let r = flex_product_rates(n);
         println!(
-            "| {b:?} | {name} | {:.1} | {:.0} | {gf:.1} | {:.2} |",
+            "flex products through burn (allocation included), f32 -> bf16 GFLOP/s: \
+             [{n}, 128] x [128, 128] {:.1} -> {:.1} ({:.2}x); weight gradient {:.1} -> {:.1} \
+             ({:.2}x); input gradient [{n}, 128] x [128, 128]^T {:.1} -> {:.1} ({:.2}x) \
+             (bf16 native: {})",
+            r[0].0,
+            r[0].1,
+            r[0].1 / r[0].0,
+            r[1].0,
+            r[1].1,
+            r[1].1 / r[1].0,
+            r[2].0,
+            r[2].1,
+            r[2].1 / r[2].0,
+            MatmulPrecision::bf16_native()
+        );
+    }
+    println!(
+        "| backend | precision | model | step ms | samples/s | GFLOP/s | fraction of 2048^3 gemm |"
+    );
+    println!("| --- | --- | --- | ---: | ---: | ---: | ---: |");
+    for (b, p, name, secs, gf) in summary {
+        println!(
+            "| {b:?} | {} | {name} | {:.1} | {:.0} | {gf:.1} | {:.2} |",
+            p.name(),
             secs * 1e3,
             n as f64 / secs,
             gf / square
         );
     }
     if !versus_pytorch.is_empty() {
-        println!("\nSingle MLP step, back to back with PyTorch (medians of 10 steps):");
-        println!("| backend | ours ms | PyTorch ms | ours / PyTorch |");
-        println!("| --- | ---: | ---: | ---: |");
-        for (b, ours, theirs) in versus_pytorch {
-            println!("| {b:?} | {:.1} | {:.1} | {:.3} |", ours * 1e3, theirs * 1e3, ours / theirs);
+        println!("\nSingle MLP step, back to back with PyTorch (medians of 10 steps; bf16 against");
+        println!("PyTorch's bf16 autocast):");
+        println!("| backend | precision | ours ms | PyTorch ms | ours / PyTorch |");
+        println!("| --- | --- | ---: | ---: | ---: |");
+        for (b, p, ours, theirs) in versus_pytorch {
+            let (o, t) = (ours * 1e3, theirs * 1e3);
+            println!("| {b:?} | {} | {o:.1} | {t:.1} | {:.3} |", p.name(), ours / theirs);
         }
     }
+}
+
+fn precisions() -> Vec<MatmulPrecision> {
+    let spec = std::env::var("BRDF_BENCH_PRECISION").unwrap_or_else(|_| "f32".into());
+    spec.split(',')
+        .map(|p| match p.trim() {
+            "f32" => MatmulPrecision::F32,
+            "bf16" => MatmulPrecision::Bf16,
+            other => panic!("BRDF_BENCH_PRECISION: unknown precision {other:?} (f32, bf16)"),
+        })
+        .collect()
+}
+
+/// Every backend with every precision it implements (bf16: flex only).
+fn backends_and_precisions() -> Vec<(Backend, MatmulPrecision)> {
+    let mut out = Vec::new();
+    for b in backends() {
+        for p in precisions() {
+            if p == MatmulPrecision::F32 || b == Backend::Flex {
+                out.push((b, p));
+            }
+        }
+    }
+    out
+}
+
+/// GFLOP/s (f32, bf16) of flex's products through burn tensors, best of 11: the forward
+/// [n, 128] x [128, 128], the weight gradient X^T dY and the input gradient dY W^T.
+fn flex_product_rates(n: usize) -> [(f64, f64); 3] {
+    let device = Backend::Flex.training_device().expect("flex");
+    let x: Tensor<2> = Tensor::random([n, 128], Distribution::Uniform(-1.0, 1.0), &device);
+    let dy: Tensor<2> = Tensor::random([n, 128], Distribution::Uniform(-1.0, 1.0), &device);
+    let w: Tensor<2> = Tensor::random([128, 128], Distribution::Uniform(-1.0, 1.0), &device);
+    let flops = 2.0 * (n * 128 * 128) as f64;
+    let rate = |p: MatmulPrecision, f: &dyn Fn() -> Tensor<2>| {
+        let _g = p.scope(Backend::Flex).expect("flex");
+        let mut best = f64::INFINITY;
+        for _ in 0..11 {
+            let t = Instant::now();
+            std::hint::black_box(f());
+            best = best.min(t.elapsed().as_secs_f64());
+        }
+        flops / best / 1e9
+    };
+    let products: [&dyn Fn() -> Tensor<2>; 3] =
+        [&|| x.clone().matmul(w.clone()), &|| x.clone().transpose().matmul(dy.clone()), &|| {
+            dy.clone().matmul(w.clone().transpose())
+        }];
+    products.map(|f| (rate(MatmulPrecision::F32, f), rate(MatmulPrecision::Bf16, f)))
 }
 
 fn rayon_threads() -> usize {

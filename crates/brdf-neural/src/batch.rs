@@ -57,11 +57,14 @@ impl ModelConfig {
         if swap.is_some_and(|m| m.len() != n) {
             return Err(Error::BatchShape("swap mask length differs from the batch".into()));
         }
-        let spatial: Vec<f32> = s
-            .spatial
-            .iter()
-            .map(|&x| if x.is_nan() { 0.0 } else { x.clamp(-SPATIAL_LIMIT, SPATIAL_LIMIT) })
-            .collect();
+        let spatial: Vec<f32> = {
+            use rayon::prelude::*;
+            s.spatial
+                .par_iter()
+                .with_min_len(1 << 14)
+                .map(|&x| if x.is_nan() { 0.0 } else { x.clamp(-SPATIAL_LIMIT, SPATIAL_LIMIT) })
+                .collect()
+        };
         let spatial = Tensor::from_data(TensorData::new(spatial, [n, self.spatial_dim]), device);
         let angles = self.uses_angle_features().then(|| {
             let d = self.angles.dim();

@@ -125,12 +125,18 @@ impl AngleConfig {
         if let Some(s) = swap {
             assert_eq!(s.len(), l.len(), "encode_batch: swap mask length");
         }
+        use rayon::prelude::*;
         let d = self.dim();
         let mut out = vec![0.0; l.len() * d];
-        for (i, row) in out.chunks_exact_mut(d).enumerate() {
-            let (a, b) = if swap.is_some_and(|s| s[i]) { (v[i], l[i]) } else { (l[i], v[i]) };
-            self.encode_into(a, b, row);
-        }
+        // Rows are independent: chunks of rows in parallel (the same values on any thread count).
+        const ROWS: usize = 1024;
+        out.par_chunks_mut(ROWS * d).enumerate().for_each(|(c, chunk)| {
+            for (j, row) in chunk.chunks_exact_mut(d).enumerate() {
+                let i = c * ROWS + j;
+                let (a, b) = if swap.is_some_and(|s| s[i]) { (v[i], l[i]) } else { (l[i], v[i]) };
+                self.encode_into(a, b, row);
+            }
+        });
         out
     }
 

@@ -78,6 +78,7 @@ pub mod model;
 pub mod output;
 pub mod output_init;
 pub mod parametric;
+pub mod precision;
 pub mod single_mlp;
 pub mod tensor_brdf;
 

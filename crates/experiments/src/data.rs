@@ -128,16 +128,28 @@ impl TrainingData {
 
     /// Gathers the records at `indices`.
     pub fn gather(&self, indices: &[usize]) -> CpuBatch {
+        use rayon::prelude::*;
         let k = self.spatial_dim;
+        // The spatial rows are most of the bytes and random reads: copied in parallel chunks.
+        const ROWS: usize = 256;
+        let mut spatial = vec![0.0; indices.len() * k];
+        if k > 0 {
+            spatial.par_chunks_mut(ROWS * k).zip(indices.par_chunks(ROWS)).for_each(
+                |(dst, idx)| {
+                    for (d, &i) in dst.chunks_exact_mut(k).zip(idx) {
+                        d.copy_from_slice(&self.spatial[i * k..(i + 1) * k]);
+                    }
+                },
+            );
+        }
         let mut b = CpuBatch {
-            spatial: Vec::with_capacity(indices.len() * k),
+            spatial,
             l: Vec::with_capacity(indices.len()),
             v: Vec::with_capacity(indices.len()),
             weight: Vec::with_capacity(indices.len() * 3),
             target_gamma: Vec::with_capacity(indices.len() * 3),
         };
         for &i in indices {
-            b.spatial.extend_from_slice(&self.spatial[i * k..(i + 1) * k]);
             b.l.push(self.l[i]);
             b.v.push(self.v[i]);
             b.weight.extend_from_slice(&self.weight[i]);

@@ -213,8 +213,11 @@ pub fn fit_and_keep(
     let resumed_from = state.step;
     let bar = progress_bar(options.progress, t.iterations, state.step);
     let lp = Loop { config, run: &dir, data: &data, val: &val, device, bar };
+    // The matrix-product precision of this thread's training steps; evaluation keeps f32.
+    let precision = t.matmul_precision.scope(options.backend)?;
     let end =
         lp.run(model, &mut optim, state, last_checkpoint, options.hook, options.stop_after)?;
+    drop(precision);
     let (model, state) = match end {
         LoopEnd::Done(done) => *done,
         LoopEnd::Interrupted(step) => return Ok((FitOutcome::Stopped(step), None)),

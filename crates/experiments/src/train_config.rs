@@ -48,6 +48,7 @@
 //! | `log_every` | 10 | 10 | 100 |
 //! | `snapshots` | false | false | false |
 //! | `diffuse_reg_weight`, `specular_reg_weight` | 5e-4 | 5e-4 | 5e-4 |
+//! | `matmul_precision` | f32 | f32 | f32 |
 //!
 //! `quick` decays once (1e-3 to 1e-4) and stops at the next plateau, with 200 steps of patience at
 //! the floor: the default profile's
@@ -59,8 +60,12 @@
 //! least-squares constant BRDF of the training records ([`crate::data::TrainingData::mean_brdf`]),
 //! so that an untrained model renders at the right brightness; `adam_epsilon` defaults to
 //! PyTorch's 1e-8 (burn's own default, 1e-5, damps every update whose gradient is that small).
+//! `matmul_precision = "bf16"` trains with the network's large matrix products on bf16 operands
+//! and f32 sums ([`brdf_neural::precision`], the CPU backend only; evaluation stays f32);
+//! `docs/reproduce.md` gives its measured speed and what it does to the converged scores.
 
 use crate::{Error, Result};
+use brdf_neural::precision::MatmulPrecision;
 use serde::{Deserialize, Serialize};
 
 /// Which defaults a run starts from.
@@ -126,6 +131,7 @@ struct RawTrain {
     snapshots: Option<bool>,
     diffuse_reg_weight: Option<f64>,
     specular_reg_weight: Option<f64>,
+    matmul_precision: Option<MatmulPrecision>,
 }
 
 /// The training schedule, resolved against the profile's defaults (deserialised through a
@@ -179,6 +185,14 @@ pub struct TrainConfig {
     pub diffuse_reg_weight: f64,
     /// Weight of the enhanced split's specular regulariser.
     pub specular_reg_weight: f64,
+    /// Precision of the training step's matrix products (f32 or bf16 operands). Not serialised
+    /// when f32, so existing run ids are unchanged.
+    #[serde(skip_serializing_if = "is_f32")]
+    pub matmul_precision: MatmulPrecision,
+}
+
+fn is_f32(p: &MatmulPrecision) -> bool {
+    *p == MatmulPrecision::F32
 }
 
 impl TrainConfig {
@@ -206,6 +220,7 @@ impl TrainConfig {
             snapshots: false,
             diffuse_reg_weight: 5e-4,
             specular_reg_weight: 5e-4,
+            matmul_precision: MatmulPrecision::F32,
         };
         match profile {
             Profile::Quick => quick,
@@ -391,6 +406,7 @@ impl<'de> Deserialize<'de> for TrainConfig {
             snapshots: r.snapshots.unwrap_or(p.snapshots),
             diffuse_reg_weight: r.diffuse_reg_weight.unwrap_or(p.diffuse_reg_weight),
             specular_reg_weight: r.specular_reg_weight.unwrap_or(p.specular_reg_weight),
+            matmul_precision: r.matmul_precision.unwrap_or(p.matmul_precision),
         })
     }
 }
@@ -449,5 +465,17 @@ mod tests {
         assert!(t.validate().unwrap_err().to_string().contains("train.lr_decay"));
         let t = TrainConfig { adam_epsilon: 0.0, ..Default::default() };
         assert!(t.validate().unwrap_err().to_string().contains("train.adam_epsilon"));
+    }
+
+    #[test]
+    fn matmul_precision_parses_and_stays_out_of_f32_run_ids() {
+        let t: TrainConfig = toml::from_str("matmul_precision = \"bf16\"").unwrap();
+        assert_eq!(t.matmul_precision, MatmulPrecision::Bf16);
+        assert!(serde_json::to_string(&t).unwrap().contains("\"matmul_precision\":\"bf16\""));
+        let t: TrainConfig = toml::from_str("").unwrap();
+        assert_eq!(t.matmul_precision, MatmulPrecision::F32);
+        assert!(!serde_json::to_string(&t).unwrap().contains("matmul_precision"));
+        let bad = toml::from_str::<TrainConfig>("matmul_precision = \"f16\"").unwrap_err();
+        assert!(bad.to_string().contains("f16"), "{bad}");
     }
 }

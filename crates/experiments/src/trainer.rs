@@ -185,7 +185,10 @@ impl Loop<'_> {
         if self.val.is_empty() || !state.step.is_multiple_of(t.validate_every) {
             return Ok(None);
         }
+        // In f32 even when the steps run bf16 products: the plateau rule compares these losses.
+        let f32_products = brdf_neural::precision::MatmulPrecision::f32_scope();
         let v = validation_loss(model, self.config, self.val, &self.device.clone().inner())?;
+        drop(f32_products);
         match state.plateau.update(state.step, v, t) {
             Decision::Stop => state.stopped = Some(StopReason::Plateau),
             Decision::Decayed | Decision::Continue => {}

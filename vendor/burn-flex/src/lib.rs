@@ -43,6 +43,10 @@ pub mod ops;
 pub mod simd;
 
 pub use backend::{Flex, FlexDevice};
+#[cfg(feature = "std")]
+pub use ops::matmul_bf16dot::{
+    MatmulPrecision, bf16_dot_native, f32_matmul_precision, set_f32_matmul_precision,
+};
 pub use layout::Layout;
 pub use qtensor::FlexQTensor;
 pub use tensor::FlexTensor;

@@ -1,0 +1,104 @@
+//! Precision of the f32 matrix products in training: plain f32, or bf16 dot products.
+//!
+//! [`MatmulPrecision::Bf16`] is the CPU counterpart of PyTorch's
+//! `torch.set_float32_matmul_precision("medium")`: the operands of the network's large matrix
+//! products are rounded to bfloat16 (8 significant bits), the products summed in f32; weights,
+//! activations, gradients and Adam stay f32. On CPUs with AVX512-BF16 the products run at twice
+//! the multiply-adds per instruction of f32 (`vdpbf16ps`, in the patched flex backend); elsewhere
+//! the same rounding is emulated, slower than f32. Only the flex CPU backend implements it.
+//!
+//! The setting is per thread: [`MatmulPrecision::scope`] applies it to the products the calling
+//! thread issues until the returned guard drops, so an evaluation on another thread (or after
+//! the fit) keeps f32; [`MatmulPrecision::f32_scope`] returns to f32 inside a bf16 scope (the
+//! training loop's validation loss, which decides the plateau schedule, is f32). Products that gain nothing (narrow heads such as the 3-channel output,
+//! small or batched products) stay f32.
+
+use serde::{Deserialize, Serialize};
+
+/// How the f32 matrix products of a training step are computed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MatmulPrecision {
+    /// f32 operands, f32 sums (the default).
+    #[default]
+    F32,
+    /// Operands rounded to bf16, products summed in f32.
+    Bf16,
+}
+
+impl MatmulPrecision {
+    /// The config and command-line spelling.
+    pub fn name(self) -> &'static str {
+        match self {
+            MatmulPrecision::F32 => "f32",
+            MatmulPrecision::Bf16 => "bf16",
+        }
+    }
+
+    /// Applies this precision to the matrix products the calling thread issues on `backend`
+    /// until the guard drops.
+    ///
+    /// # Errors
+    /// [`crate::Error::InvalidConfig`] for bf16 on a backend other than flex.
+    pub fn scope(self, backend: crate::device::Backend) -> crate::Result<PrecisionGuard> {
+        if self == MatmulPrecision::F32 {
+            return Ok(PrecisionGuard { previous: None });
+        }
+        if backend != crate::device::Backend::Flex {
+            return Err(crate::Error::InvalidConfig(format!(
+                "matmul precision bf16 is implemented for the flex CPU backend only, not {}",
+                backend.name()
+            )));
+        }
+        Ok(PrecisionGuard { previous: Some(set(self)) })
+    }
+
+    /// Plain f32 products on the calling thread until the guard drops, whatever was set before
+    /// (a training loop's validation loss and other measurements inside a bf16 scope).
+    pub fn f32_scope() -> PrecisionGuard {
+        PrecisionGuard { previous: Some(set(MatmulPrecision::F32)) }
+    }
+
+    /// Whether this CPU runs bf16 products natively (otherwise they are emulated, slowly).
+    pub fn bf16_native() -> bool {
+        #[cfg(feature = "flex")]
+        {
+            burn_flex::bf16_dot_native()
+        }
+        #[cfg(not(feature = "flex"))]
+        {
+            false
+        }
+    }
+}
+
+/// Restores the thread's previous matrix-product precision when dropped.
+#[must_use = "the precision applies only while the guard lives"]
+pub struct PrecisionGuard {
+    previous: Option<MatmulPrecision>,
+}
+
+impl Drop for PrecisionGuard {
+    fn drop(&mut self) {
+        if let Some(p) = self.previous {
+            set(p);
+        }
+    }
+}
+
+#[cfg(feature = "flex")]
+fn set(p: MatmulPrecision) -> MatmulPrecision {
+    let flex = match p {
+        MatmulPrecision::F32 => burn_flex::MatmulPrecision::Highest,
+        MatmulPrecision::Bf16 => burn_flex::MatmulPrecision::Bf16,
+    };
+    match burn_flex::set_f32_matmul_precision(flex) {
+        burn_flex::MatmulPrecision::Highest => MatmulPrecision::F32,
+        burn_flex::MatmulPrecision::Bf16 => MatmulPrecision::Bf16,
+    }
+}
+
+#[cfg(not(feature = "flex"))]
+fn set(_: MatmulPrecision) -> MatmulPrecision {
+    MatmulPrecision::F32
+}
