@@ -2,9 +2,9 @@
 //! command (see `experiments::sweep` for the profiles, the run layout and the tables).
 
 use anyhow::{Context, Result};
-use experiments::Backend;
 use experiments::run_dir::SweepLayout;
 use experiments::sweep::{self, Execution, SweepProfile};
+use experiments::{Backend, MatmulPrecision};
 use std::path::{Path, PathBuf};
 
 /// Options of `reproduce-tables`.
@@ -21,6 +21,8 @@ pub struct Options {
     pub data_root: PathBuf,
     /// The burn backend every run trains and evaluates on.
     pub backend: Backend,
+    /// Precision of every run's training matrix products (`train.matmul_precision`).
+    pub matmul_precision: MatmulPrecision,
 }
 
 /// The data root: `NEURAL_BRDF_DATA`, else `./data`.
@@ -41,7 +43,13 @@ pub fn reproduce(opts: Options) -> Result<()> {
         "--backend {0}: this xtask was built without it; rebuild with `--features {0}`",
         opts.backend
     );
-    let profile = SweepProfile::load(&opts.profile)?;
+    anyhow::ensure!(
+        opts.matmul_precision == MatmulPrecision::F32 || opts.backend == Backend::Flex,
+        "--matmul-precision bf16 is implemented for the CPU backend only, not --backend {}",
+        opts.backend
+    );
+    let profile =
+        SweepProfile::load(&opts.profile)?.with_matmul_precision(opts.matmul_precision)?;
     eprintln!("profile {}: {}", profile.name, profile.description);
     let how = match (&opts.emit_jobs, opts.jobs) {
         (Some(file), _) => {

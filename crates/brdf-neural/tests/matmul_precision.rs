@@ -5,6 +5,7 @@
 //! left operand as in the weight gradient, a transposed right operand as in the input gradient)
 //! and for shapes with tails (odd k, rows not a multiple of the tile, columns not a multiple of
 //! the panel). The same products under the default precision must be the plain f32 ones.
+#![cfg(feature = "flex")]
 
 use brdf_neural::device::Backend;
 use brdf_neural::precision::MatmulPrecision;
@@ -159,6 +160,20 @@ fn default_precision_is_plain_f32_and_the_guard_restores_it() {
     let other =
         std::thread::spawn(move || product(&a, &b, m, k, n, Layout::RowMajor)).join().unwrap();
     assert!(max_scaled_error(&other, &exact, &scale) < 1e-5);
+}
+
+#[test]
+fn the_emulation_for_cpus_without_bf16_agrees() {
+    // Machines without AVX512-BF16 round the operands and call the f32 gemm instead.
+    for &(m, k, n) in &SHAPES[3..] {
+        let mut r = rng(m as u64);
+        let a: Vec<f32> = (0..m * k).map(|_| r()).collect();
+        let b: Vec<f32> = (0..k * n).map(|_| r()).collect();
+        let got = burn_flex::ops::matmul_bf16dot::emulated_row_major(m, n, k, &a, &b);
+        let (want, scale) = reference(&a, &b, m, k, n, bf16);
+        let err = max_scaled_error(&got, &want, &scale);
+        assert!(err < 4e-6 * (k as f64).sqrt(), "{m}x{k}x{n}: emulated error {err:e}");
+    }
 }
 
 #[test]

@@ -49,6 +49,7 @@ pub mod trainer;
 
 /// The burn backend a fit or an evaluation runs on (`--backend`).
 pub use brdf_neural::device::Backend;
+pub use brdf_neural::precision::MatmulPrecision;
 pub use config::{RunConfig, TrainConfig};
 pub use error::{Error, Result};
 pub use train::{FitOptions, FitOutcome, fit};

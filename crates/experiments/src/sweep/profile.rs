@@ -32,6 +32,7 @@
 
 use crate::{Error, Result};
 use brdf_neural::ModelKind;
+use brdf_neural::precision::MatmulPrecision;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -182,6 +183,22 @@ impl SweepProfile {
         };
         p.validate()?;
         Ok(p)
+    }
+
+    /// Sets `train.matmul_precision` in the run configuration every run shares
+    /// (`reproduce-tables --matmul-precision`). A bf16 run gets its own run id, so a sweep
+    /// never mixes precisions in one run directory.
+    pub fn with_matmul_precision(mut self, precision: MatmulPrecision) -> Result<Self> {
+        let parse = |e: String| Error::ConfigParse { path: self.origin.clone().into(), message: e };
+        let mut run: toml::Table = toml::from_str(&self.run).map_err(|e| parse(e.to_string()))?;
+        let train = run.entry("train").or_insert_with(|| toml::Value::Table(Default::default()));
+        let Some(train) = train.as_table_mut() else {
+            return Err(Error::config("run.train", format!("is not a table (in {})", self.origin)));
+        };
+        train.insert("matmul_precision".into(), toml::Value::String(precision.name().into()));
+        self.run = toml::to_string(&run).map_err(|e| parse(e.to_string()))?;
+        self.validate()?;
+        Ok(self)
     }
 
     fn validate(&self) -> Result<()> {
@@ -343,5 +360,23 @@ mod tests {
         assert!(resolve_mesh("embedded:spot", Path::new(".")).is_ok());
         let e = resolve_mesh("data:meshes/nope.obj", Path::new("/nonexistent")).unwrap_err();
         assert!(e.to_string().contains("fetch-data"), "{e}");
+    }
+
+    #[test]
+    fn matmul_precision_reaches_every_run_config() {
+        let p = SweepProfile::load("smoke").unwrap();
+        let ids = |p: &SweepProfile| -> Vec<String> {
+            let runs = crate::sweep::plan::runs(p).unwrap();
+            runs.iter().map(|r| crate::sweep::plan::run_id(&r.config, "scene").unwrap()).collect()
+        };
+        let before = ids(&p);
+        let bf16 = p.clone().with_matmul_precision(MatmulPrecision::Bf16).unwrap();
+        let config = crate::RunConfig::from_toml(&bf16.run, Path::new("test")).unwrap();
+        assert_eq!(config.train.matmul_precision, MatmulPrecision::Bf16);
+        let after = ids(&bf16);
+        assert_eq!(before.len(), after.len());
+        assert!(before.iter().zip(&after).all(|(a, b)| a != b), "bf16 runs need their own ids");
+        // f32 is the default: setting it explicitly changes no run id.
+        assert_eq!(ids(&p.with_matmul_precision(MatmulPrecision::F32).unwrap()), before);
     }
 }

@@ -134,6 +134,23 @@ pub(crate) unsafe fn matmul_bf16dot(
     unsafe { emulated(m, n, k, lhs, rhs, core::slice::from_raw_parts_mut(out, m * n)) };
 }
 
+/// The emulated path on row-major operands (what CPUs without AVX512-BF16 run), public so
+/// that tests on any machine can check it: `a` is m x k, `b` is k x n, the result m x n.
+///
+/// # Panics
+/// If the slice lengths do not match the shapes.
+pub fn emulated_row_major(m: usize, n: usize, k: usize, a: &[f32], b: &[f32]) -> Vec<f32> {
+    assert!(a.len() == m * k && b.len() == k * n, "emulated_row_major: shapes");
+    let mut out = vec![0f32; m * n];
+    let lhs = MatRef { ptr: a.as_ptr(), rs: k as isize, cs: 1 };
+    let rhs = MatRef { ptr: b.as_ptr(), rs: n as isize, cs: 1 };
+    if m > 0 && n > 0 && k > 0 {
+        // SAFETY: the views address exactly the checked slices.
+        unsafe { emulated(m, n, k, lhs, rhs, &mut out) };
+    }
+    out
+}
+
 /// The reference: operands rounded to bf16, then the f32 gemm (exact products, f32 sums).
 ///
 /// # Safety
