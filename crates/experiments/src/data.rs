@@ -17,16 +17,22 @@ use rand::seq::SliceRandom;
 use scene::Split;
 use scene::shading::light_weight;
 use scene::{SampleSet, SceneDataset};
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
+use std::sync::Arc;
 
 /// Samples ready for batching, struct of arrays.
 #[derive(Clone, Debug, Default)]
 pub struct TrainingData {
-    /// Spatial features, row-major `[n, spatial_dim]`.
-    pub spatial: Vec<f32>,
+    /// Spatial features of the distinct surface points, row-major `[points, spatial_dim]`,
+    /// shared between the training and validation records (a pixel's records under all its
+    /// lights are one point: 42x less memory than a row per record, which at 512 px would not
+    /// fit in memory).
+    pub spatial: Arc<Vec<f32>>,
     /// Width of a spatial row.
     pub spatial_dim: usize,
+    /// The point (row of `spatial`) of each record.
+    pub point: Vec<u32>,
     /// Direction to the light, local frame (normal on +z).
     pub l: Vec<[f32; 3]>,
     /// Direction to the viewer, local frame.
@@ -72,19 +78,22 @@ impl TrainingData {
 
     /// Builds the records from `samples` with per-sample spatial features `spatial`
     /// (`[samples.len(), spatial_dim]`).
-    pub fn new(samples: &SampleSet, spatial: &[f32], spatial_dim: usize) -> Self {
-        Self::from_indices(samples, spatial, spatial_dim, 0..samples.len())
+    pub fn new(samples: &SampleSet, spatial: &SpatialFeatures) -> Self {
+        Self::from_indices(samples, spatial, 0..samples.len())
     }
 
     /// Builds the records of the samples at `indices` (into `samples` and the rows of
     /// `spatial`), in that order.
     pub fn from_indices(
         samples: &SampleSet,
-        spatial: &[f32],
-        spatial_dim: usize,
+        spatial: &SpatialFeatures,
         indices: impl IntoIterator<Item = usize>,
     ) -> Self {
-        let mut d = TrainingData { spatial_dim, ..Default::default() };
+        let mut d = TrainingData {
+            spatial: spatial.table.clone(),
+            spatial_dim: spatial.dim,
+            ..Default::default()
+        };
         for i in indices {
             let n = samples.normal[i];
             let (lw, vw) = (samples.l[i], samples.v[i]);
@@ -98,10 +107,25 @@ impl TrainingData {
             let o = samples.observed[i];
             d.observed.push(o);
             d.observed_gamma.push(o.map(srgb_oetf));
-            d.spatial.extend_from_slice(&spatial[i * spatial_dim..(i + 1) * spatial_dim]);
+            d.point.push(spatial.point[i]);
             d.source.push(i);
         }
         d
+    }
+
+    /// The spatial features of record `i`.
+    pub fn spatial_row(&self, i: usize) -> &[f32] {
+        let (p, k) = (self.point[i] as usize, self.spatial_dim);
+        &self.spatial[p * k..(p + 1) * k]
+    }
+
+    /// The spatial rows of `records`, row-major (the input of a batch).
+    pub fn spatial_rows(&self, records: std::ops::Range<usize>) -> Vec<f32> {
+        let mut out = Vec::with_capacity(records.len() * self.spatial_dim);
+        for i in records {
+            out.extend_from_slice(self.spatial_row(i));
+        }
+        out
     }
 
     /// The least-squares constant BRDF of the records, per channel: the f minimising
@@ -137,7 +161,7 @@ impl TrainingData {
             spatial.par_chunks_mut(ROWS * k).zip(indices.par_chunks(ROWS)).for_each(
                 |(dst, idx)| {
                     for (d, &i) in dst.chunks_exact_mut(k).zip(idx) {
-                        d.copy_from_slice(&self.spatial[i * k..(i + 1) * k]);
+                        d.copy_from_slice(self.spatial_row(i));
                     }
                 },
             );
@@ -211,25 +235,58 @@ pub fn split_validation(
     (train, val)
 }
 
-/// Spatial features of every sample of `samples`, `[n, dim]` row-major, and `dim`.
-///
-/// `lbo`: the mesh's LBO encoding (eigenpairs from `cache_dir`, computed and cached on a
-/// miss) interpolated at each hit; `position`: the hit's xyz.
+/// The spatial features of a sample set: one row per distinct surface point and each sample's
+/// point. Samples with the same inputs to the features (triangle and barycentrics for LBO,
+/// position for positional features), i.e. one pixel under every light, share a row, so the
+/// values are exactly those a row per sample would hold.
+#[derive(Clone, Debug, Default)]
+pub struct SpatialFeatures {
+    /// Row-major `[points, dim]`.
+    pub table: Arc<Vec<f32>>,
+    /// Row width.
+    pub dim: usize,
+    /// The row of each sample.
+    pub point: Vec<u32>,
+}
+
+/// Spatial features of `samples` under `features` ([`SpatialFeatures`]): LBO eigenfunctions
+/// interpolated barycentrically from the mesh's vertex table, or the positions.
 pub fn spatial_features(
     scene: &SceneDataset,
     samples: &SampleSet,
     features: &FeatureConfig,
     cache_dir: &Path,
-) -> Result<(Vec<f32>, usize)> {
-    match features.spatial {
+) -> Result<SpatialFeatures> {
+    // Distinct points by the exact bits of what the features are computed from.
+    let key = |i: usize| -> [u32; 3] {
+        match features.spatial {
+            SpatialKind::Position => samples.position[i].map(f32::to_bits),
+            SpatialKind::Lbo => {
+                let [b1, b2] = samples.barycentric[i];
+                [samples.triangle[i], b1.to_bits(), b2.to_bits()]
+            }
+        }
+    };
+    let mut index: HashMap<[u32; 3], u32> = HashMap::new();
+    let mut first = Vec::new();
+    let mut point = Vec::with_capacity(samples.len());
+    for i in 0..samples.len() {
+        let next = first.len() as u32;
+        let p = *index.entry(key(i)).or_insert_with(|| {
+            first.push(i);
+            next
+        });
+        point.push(p);
+    }
+    let (table, dim) = match features.spatial {
         SpatialKind::Position => {
-            Ok((samples.position.iter().flat_map(|p| p.iter().copied()).collect(), 3))
+            (first.iter().flat_map(|&i| samples.position[i].iter().copied()).collect(), 3)
         }
         SpatialKind::Lbo => {
             let (table, dim) = lbo_table(scene, features, cache_dir)?;
-            let mut out = vec![0.0; samples.len() * dim];
+            let mut out = vec![0.0; first.len() * dim];
             let tris = &scene.mesh.triangles;
-            for (i, row) in out.chunks_mut(dim).enumerate() {
+            for (row, &i) in out.chunks_mut(dim).zip(&first) {
                 let t = samples.triangle[i] as usize;
                 let [b1, b2] = samples.barycentric[i];
                 let tri = *tris.get(t).ok_or_else(|| {
@@ -243,9 +300,10 @@ pub fn spatial_features(
                     }
                 }
             }
-            Ok((out, dim))
+            (out, dim)
         }
-    }
+    };
+    Ok(SpatialFeatures { table: Arc::new(table), dim, point })
 }
 
 /// The per-vertex LBO feature table `[vertices, dim]` of the scene's mesh, from

@@ -148,8 +148,9 @@ pub fn export_merl(
             .ok_or_else(|| Error::format(&dataset.dir, "the mesh has no vertices"))?,
     };
     let data = TrainingData {
-        spatial: table[vertex * dim..(vertex + 1) * dim].to_vec(),
+        spatial: std::sync::Arc::new(table[vertex * dim..(vertex + 1) * dim].to_vec()),
         spatial_dim: dim,
+        point: vec![0],
         ..Default::default()
     };
     let brdf = ModelBrdf {

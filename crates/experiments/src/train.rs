@@ -98,13 +98,13 @@ pub fn training_data(config: &RunConfig, cache_dir: &Path) -> Result<RunData> {
     })?;
     let scene = SceneDataset::open(scene_dir)?;
     let samples = scene.samples(Split::Train)?;
-    let (spatial, dim) = spatial_features(&scene, &samples, &config.features, cache_dir)?;
+    let spatial = spatial_features(&scene, &samples, &config.features, cache_dir)?;
     let t = &config.train;
     let pairs = validation_pairs(&scene, t.validation_fraction);
     let (train, val) = split_validation(&samples, &pairs, t.validation_records, config.seed);
     let clip = crate::eval::images::clip_level(&scene);
-    let mut train = TrainingData::from_indices(&samples, &spatial, dim, train);
-    let mut val = TrainingData::from_indices(&samples, &spatial, dim, val);
+    let mut train = TrainingData::from_indices(&samples, &spatial, train);
+    let mut val = TrainingData::from_indices(&samples, &spatial, val);
     (train.clip, val.clip) = (clip, clip);
     if train.is_empty() {
         return Err(Error::NoSamples { path: scene_dir.clone() });

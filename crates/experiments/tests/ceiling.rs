@@ -3,7 +3,7 @@
 //! (the noise-free renders against the observations) to 1e-6 dB on every metric, and +inf dB
 //! against the noise-free renders; a model off by a few percent scores below the ceiling.
 
-use experiments::data::TrainingData;
+use experiments::data::{SpatialFeatures, TrainingData};
 use experiments::eval::Prediction;
 use experiments::eval::images::{RenderOptions, render_and_score};
 use scene::SceneDataset;
@@ -30,7 +30,8 @@ fn the_ground_truth_scores_the_noise_ceiling_exactly() {
     let scene = smoke_scene(&dir.0);
     assert!(scene.has_clean_renders());
     let samples = scene.samples(Split::Test).unwrap();
-    let data = TrainingData::new(&samples, &[], 0);
+    let none = SpatialFeatures { point: vec![0; samples.len()], ..Default::default() };
+    let data = TrainingData::new(&samples, &none);
     assert!(!data.is_empty());
     let gt: Vec<[f32; 3]> = data.source.iter().map(|&i| samples.gt_brdf[i]).collect();
     let opts = RenderOptions {

@@ -77,9 +77,9 @@ impl FittedRun {
     /// The lit test samples and their training records (features, local directions).
     pub fn test_records(&self) -> Result<(SampleSet, TrainingData)> {
         let samples = self.dataset.samples(Split::Test)?;
-        let (spatial, dim) =
+        let spatial =
             spatial_features(&self.dataset, &samples, &self.config.features, &self.cache)?;
-        let data = TrainingData::new(&samples, &spatial, dim);
+        let data = TrainingData::new(&samples, &spatial);
         Ok((samples, data))
     }
 }

@@ -62,11 +62,10 @@ pub fn predict(
     parts: bool,
 ) -> Result<Prediction> {
     let mut all = Prediction::default();
-    let k = data.spatial_dim;
     for start in (0..data.len()).step_by(CHUNK) {
         let end = (start + CHUNK).min(data.len());
         let samples = Samples {
-            spatial: &data.spatial[start * k..end * k],
+            spatial: &data.spatial_rows(start..end),
             l: &data.l[start..end],
             v: &data.v[start..end],
         };
@@ -104,8 +103,7 @@ impl metrics::BatchBrdf for ModelBrdf<'_> {
         let k = self.data.spatial_dim;
         let mut spatial = Vec::with_capacity(points.len() * k);
         for &p in points {
-            let p = p as usize;
-            spatial.extend_from_slice(&self.data.spatial[p * k..(p + 1) * k]);
+            spatial.extend_from_slice(self.data.spatial_row(p as usize));
         }
         let samples = Samples { spatial: &spatial, l, v };
         match forward_rows(self.model, self.config, &samples, self.device, false) {
