@@ -83,7 +83,10 @@ pub fn reproduce(opts: Options) -> Result<()> {
         );
         return Ok(());
     }
-    let c = sweep::collect(&[SweepLayout::new(&opts.out).runs()], &opts.out, &profile.name)?;
+    // The tables of this profile's runs only: an output directory that also holds runs of
+    // another profile or of the other `--matmul-precision` keeps them out of these tables
+    // (`cargo xtask collect` gathers any set).
+    let c = sweep::collect(&s.runs, &opts.out, &profile.name)?;
     eprintln!("{} run(s) collected in {:.1} min", c.runs, s.seconds / 60.0);
     print_results(&opts.out, &c.files);
     anyhow::ensure!(
