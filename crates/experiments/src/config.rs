@@ -11,7 +11,7 @@
 //! kind = "single_mlp"
 //!
 //! [features]
-//! spatial = "lbo"            # lbo | position
+//! spatial = "lbo"            # lbo | position | uniform
 //! [features.lbo]
 //! k_max = 512                # selection: 0..first, then `blocks` blocks of `block_len`
 //!
@@ -61,13 +61,16 @@ pub enum SpatialKind {
     Lbo,
     /// The hit position xyz (3 values; tests and quick checks, no eigensolve).
     Position,
+    /// One constant feature (1.0) at every point: a spatially uniform material, one parameter
+    /// set for the whole object (a homogeneous capture; exports without textures).
+    Uniform,
 }
 
 /// Spatial features: kind, LBO selection and eigenpair cache.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FeatureConfig {
-    /// `lbo` (default) or `position`.
+    /// `lbo` (default), `position` or `uniform`.
     pub spatial: SpatialKind,
     /// LBO index selection.
     pub lbo: LboSelection,
@@ -181,6 +184,7 @@ impl RunConfig {
         match self.features.spatial {
             SpatialKind::Lbo => self.features.lbo.dim(),
             SpatialKind::Position => 3,
+            SpatialKind::Uniform => 1,
         }
     }
 

@@ -261,6 +261,7 @@ pub fn spatial_features(
     let key = |i: usize| -> [u32; 3] {
         match features.spatial {
             SpatialKind::Position => samples.position[i].map(f32::to_bits),
+            SpatialKind::Uniform => [0; 3],
             SpatialKind::Lbo => {
                 let [b1, b2] = samples.barycentric[i];
                 [samples.triangle[i], b1.to_bits(), b2.to_bits()]
@@ -282,6 +283,7 @@ pub fn spatial_features(
         SpatialKind::Position => {
             (first.iter().flat_map(|&i| samples.position[i].iter().copied()).collect(), 3)
         }
+        SpatialKind::Uniform => (vec![1.0; first.len()], 1),
         SpatialKind::Lbo => {
             let (table, dim) = lbo_table(scene, features, cache_dir)?;
             let mut out = vec![0.0; first.len() * dim];

@@ -1,6 +1,7 @@
 //! The `experiments` command line: `fit` trains a model on a scene into a run directory, `eval`
-//! renders the test images of a finished run and computes its metrics, `export-merl` writes the
-//! fitted material as a MERL binary.
+//! renders the test images of a finished run and computes its metrics, `export` writes a
+//! Disney or Torrance-Sparrow fit as glTF 2.0, Mitsuba 3 and pbrt-v4 files, `export-merl` any
+//! fit as a MERL binary.
 
 use anyhow::{Context, Result, bail};
 use brdf_neural::device::Backend;
@@ -85,6 +86,27 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Write a finished Disney or Torrance-Sparrow run as renderer files: glTF 2.0
+    /// (`<out>/gltf`), a Mitsuba 3 scene (`<out>/mitsuba`) and a pbrt-v4 scene (`<out>/pbrt`),
+    /// the last two with a scene file per test view and light; `<out>/export.json` reports the
+    /// round trip (the test views re-rendered from the glTF file against the fit's renders).
+    Export {
+        /// Run directory.
+        run: PathBuf,
+        /// Output folder (replaced atomically).
+        #[arg(long)]
+        out: PathBuf,
+        /// Formats, comma-separated: gltf, mitsuba, pbrt or all.
+        #[arg(long, default_value = "all")]
+        format: String,
+        /// Scene directory (default: the one in the run's config).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Cache directory (default: `features.cache_dir`, else the sweep's `cache/` for a sweep
+        /// run, else `<run>/../cache`).
+        #[arg(long)]
+        cache: Option<PathBuf>,
+    },
     /// Write a finished run's fitted material as a MERL binary (90 x 90 x 180 bins) at one
     /// surface point, for any renderer that reads MERL files.
     ExportMerl {
@@ -137,6 +159,34 @@ fn main() -> Result<()> {
                 experiments::eval::energy_of_run(&run, estimator, pairs, cache.as_deref(), !quiet)
                     .with_context(|| format!("energy of {}", run.display()))?;
             println!("{}", serde_json::to_string_pretty(&e)?);
+        }
+        Command::Export { run, out, format, scene, cache } => {
+            let formats = experiments::export::Format::parse_list(&format)?;
+            let e = experiments::export::export(
+                &run,
+                &out,
+                &formats,
+                scene.as_deref(),
+                cache.as_deref(),
+            )
+            .with_context(|| format!("export of {}", run.display()))?;
+            println!(
+                "wrote {} files for a {} {} fit ({} vertices, {} test pairs) into {} in {:.1} s",
+                e.files.len(),
+                if e.uniform { "spatially uniform" } else { "spatially varying" },
+                e.model,
+                e.vertices,
+                e.test_pairs,
+                out.display(),
+                e.seconds
+            );
+            if let Some(t) = &e.round_trip {
+                println!(
+                    "round trip (glTF read back, {} test images re-rendered): PSNR min {:.1} dB, \
+                     mean {:.1} dB; largest relative BRDF difference {:.2e}",
+                    t.images, t.min_psnr_db, t.mean_psnr_db, t.max_relative_brdf_difference
+                );
+            }
         }
         Command::ExportMerl { run, out, vertex, scene, cache, quiet } => {
             let point = vertex.map_or(SurfacePoint::Representative, SurfacePoint::Vertex);

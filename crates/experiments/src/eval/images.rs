@@ -293,6 +293,28 @@ pub fn mean_psnr(
     Ok(psnr.iter().sum::<f64>() / t.pairs.len().max(1) as f64)
 }
 
+/// Per test pair (in [`SceneDataset::pairs`] order): the PSNR (sRGB-clamped, object mask) of
+/// the render of `f` against the render of `reference`, two BRDF values per record of `data`
+/// rendered the same way (the export round trip's score; infinite where they agree exactly).
+pub fn psnr_between(
+    dataset: &SceneDataset,
+    samples: &SampleSet,
+    data: &TrainingData,
+    f: &[[f32; 3]],
+    reference: &[[f32; 3]],
+) -> Result<Vec<f64>> {
+    let t = TestImages::new(dataset, samples, data);
+    t.pairs
+        .par_iter()
+        .map(|&(vi, li)| {
+            let records = t.records(vi, li);
+            let test = to_image(t.width, t.height, &t.render(records, f))?;
+            let refr = to_image(t.width, t.height, &t.render(records, reference))?;
+            Ok(metrics::psnr_linear(&test, &refr, Some(&t.mask(vi)))?)
+        })
+        .collect()
+}
+
 /// The test pairs of a scene and their records, for rendering.
 struct TestImages<'a> {
     dataset: &'a SceneDataset,

@@ -17,7 +17,7 @@ pub mod analyses;
 pub mod fitted;
 pub mod images;
 pub mod predict;
-mod serde_inf;
+pub(crate) mod serde_inf;
 pub mod settings;
 
 pub use analyses::EnergySummary;

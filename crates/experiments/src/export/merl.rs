@@ -10,8 +10,8 @@
 //! surface point is a mesh vertex; by default the one whose spatial features are closest
 //! (Euclidean) to the mean over all vertices, i.e. the most "average" point of the object.
 
-use crate::config::{RunConfig, SpatialKind};
-use crate::data::{TrainingData, lbo_table};
+use super::{SurfacePoint, representative_row, vertex_features};
+use crate::data::TrainingData;
 use crate::eval::{FittedRun, ModelBrdf};
 use crate::{Error, Result};
 use angles::Rusinkiewicz;
@@ -19,18 +19,7 @@ use dataset_merl::MerlBrdf;
 use dataset_merl::merl::format::TABLE_LEN;
 use dataset_merl::merl::lookup::bin_lower_edges;
 use metrics::BatchBrdf;
-use scene::SceneDataset;
 use std::path::Path;
-
-/// Which surface point the table describes.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum SurfacePoint {
-    /// The vertex whose features are closest to the mean over all vertices.
-    #[default]
-    Representative,
-    /// A given vertex index.
-    Vertex(usize),
-}
 
 /// What [`export_merl`] wrote.
 #[derive(Clone, Debug, PartialEq)]
@@ -43,39 +32,6 @@ pub struct MerlExport {
     pub below_horizon: usize,
     /// Wall-clock seconds.
     pub seconds: f64,
-}
-
-/// The per-vertex spatial features `[vertices, dim]` of a scene's mesh under `config`.
-pub fn vertex_features(
-    scene: &SceneDataset,
-    config: &RunConfig,
-    cache: &Path,
-) -> Result<(Vec<f32>, usize)> {
-    match config.features.spatial {
-        SpatialKind::Lbo => lbo_table(scene, &config.features, cache),
-        SpatialKind::Position => {
-            Ok((scene.mesh.positions.iter().flat_map(|p| p.to_array()).collect(), 3))
-        }
-    }
-}
-
-/// The row of `table` (`[n, dim]`) closest to the mean row.
-pub fn representative_row(table: &[f32], dim: usize) -> Option<usize> {
-    let n = table.len().checked_div(dim)?;
-    if n == 0 {
-        return None;
-    }
-    let mut mean = vec![0.0f64; dim];
-    for row in table.chunks_exact(dim) {
-        for (m, &x) in mean.iter_mut().zip(row) {
-            *m += x as f64 / n as f64;
-        }
-    }
-    let dist =
-        |row: &[f32]| -> f64 { row.iter().zip(&mean).map(|(&x, m)| (x as f64 - m).powi(2)).sum() };
-    (0..n).min_by(|&a, &b| {
-        dist(&table[a * dim..(a + 1) * dim]).total_cmp(&dist(&table[b * dim..(b + 1) * dim]))
-    })
 }
 
 /// Tabulates `brdf` at surface point `point` over every MERL bin; returns the table and the

@@ -1,0 +1,155 @@
+//! `experiments export`: a finished Disney or Torrance-Sparrow run as renderer files, written
+//! atomically into one folder:
+//!
+//! ```text
+//! <out>/gltf/<name>.gltf, <name>.bin      glTF 2.0, metallic-roughness (+ specular, clear coat)
+//! <out>/mitsuba/object.xml, mesh.ply, view<v>_light<l>.xml   Mitsuba 3
+//! <out>/pbrt/object.pbrt, mesh.ply, view<v>_light<l>.pbrt    pbrt-v4
+//! <out>/export.json                        what was written, the mapping's model and the round trip
+//! ```
+//!
+//! The glTF asset is read back with the `gltf` crate and re-rendered ([`super::round_trip`]).
+
+use super::gltf::ExportMesh;
+use super::material::{ExportedMaterial, MaterialKind};
+use super::round_trip::{RoundTrip, round_trip};
+use super::{gltf, mitsuba, pbrt, test_pairs};
+use crate::eval::FittedRun;
+use crate::{Error, Result};
+use serde::Serialize;
+use std::path::Path;
+
+/// A renderer format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Format {
+    /// glTF 2.0 (`.gltf` + `.bin`).
+    Gltf,
+    /// Mitsuba 3 scene XML.
+    Mitsuba,
+    /// pbrt-v4 scene.
+    Pbrt,
+}
+
+impl Format {
+    /// Every format.
+    pub const ALL: [Format; 3] = [Format::Gltf, Format::Mitsuba, Format::Pbrt];
+
+    /// Parses `gltf`, `mitsuba`, `pbrt` or `all` (every format).
+    pub fn parse_list(text: &str) -> Result<Vec<Format>> {
+        let mut out = Vec::new();
+        for name in text.split(',').map(str::trim) {
+            match name {
+                "gltf" => out.push(Format::Gltf),
+                "mitsuba" => out.push(Format::Mitsuba),
+                "pbrt" => out.push(Format::Pbrt),
+                "all" => out.extend(Format::ALL),
+                other => {
+                    return Err(Error::config(
+                        "format",
+                        format!("{other:?}: expected gltf, mitsuba, pbrt or all"),
+                    ));
+                }
+            }
+        }
+        out.dedup();
+        Ok(out)
+    }
+
+    /// The sub-folder name.
+    pub fn dir(self) -> &'static str {
+        match self {
+            Format::Gltf => "gltf",
+            Format::Mitsuba => "mitsuba",
+            Format::Pbrt => "pbrt",
+        }
+    }
+}
+
+/// What [`export`] wrote (also `<out>/export.json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct ExportSummary {
+    /// `disney` or `torrance_sparrow`.
+    pub model: &'static str,
+    /// Whether the fit is spatially uniform (one parameter row for the object).
+    pub uniform: bool,
+    /// Mesh vertices (= material rows).
+    pub vertices: usize,
+    /// The mean parameter row, by column name.
+    pub mean_parameters: serde_json::Map<String, serde_json::Value>,
+    /// Test (view, light) pairs written as renderer scenes.
+    pub test_pairs: usize,
+    /// Files, relative to the output folder.
+    pub files: Vec<String>,
+    /// The glTF round trip (when glTF was written).
+    pub round_trip: Option<RoundTrip>,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+}
+
+/// Exports the finished run `run` into the folder `out` (replaced atomically).
+pub fn export(
+    run: &Path,
+    out: &Path,
+    formats: &[Format],
+    scene: Option<&Path>,
+    cache: Option<&Path>,
+) -> Result<ExportSummary> {
+    let start = std::time::Instant::now();
+    let fitted = FittedRun::open(run, scene, cache)?;
+    let material = ExportedMaterial::from_run(&fitted)?;
+    let mesh = &fitted.dataset.mesh;
+    let positions: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.to_array()).collect();
+    let normals: Vec<[f32; 3]> = mesh
+        .vertex_normals(mesh_encoding::NormalWeighting::default())
+        .iter()
+        .map(|n| n.to_array())
+        .collect();
+    let export_mesh =
+        ExportMesh { positions: &positions, normals: &normals, triangles: &mesh.triangles };
+    let pairs = test_pairs(&fitted.dataset);
+    let name = match material.kind {
+        MaterialKind::Disney => "disney",
+        MaterialKind::TorranceSparrow => "torrance_sparrow",
+    };
+    let dirs: Vec<&str> = formats.iter().map(|f| f.dir()).collect();
+    stdx::fs::write_dir_atomic(out, &dirs, |tmp| {
+        let mut files = Vec::new();
+        let mut trip = None;
+        for &f in formats {
+            let dir = tmp.join(f.dir());
+            let written = match f {
+                Format::Gltf => {
+                    gltf::write(&dir, name, &export_mesh, &material)?;
+                    let back = gltf::read(&dir.join(format!("{name}.gltf")))?;
+                    trip = Some(round_trip(&fitted, &back)?);
+                    vec![format!("{name}.gltf"), format!("{name}.bin")]
+                }
+                Format::Mitsuba => mitsuba::write(&dir, &export_mesh, &material, &pairs)?,
+                Format::Pbrt => pbrt::write(&dir, &export_mesh, &material, &pairs)?,
+            };
+            files.extend(written.into_iter().map(|w| format!("{}/{w}", f.dir())));
+        }
+        let mean = material.mean();
+        let summary = ExportSummary {
+            model: name,
+            uniform: material.is_uniform(),
+            vertices: material.len(),
+            mean_parameters: material
+                .kind
+                .columns()
+                .iter()
+                .zip(&mean)
+                .map(|(c, v)| (c.to_string(), serde_json::json!(v)))
+                .collect(),
+            test_pairs: pairs.len(),
+            files,
+            round_trip: trip,
+            seconds: start.elapsed().as_secs_f64(),
+        };
+        let json =
+            serde_json::to_vec_pretty(&summary).map_err(|e| Error::format(out, e.to_string()))?;
+        stdx::fs::write_atomic(&tmp.join("export.json"), &json)?;
+        Ok(summary)
+    })
+}
