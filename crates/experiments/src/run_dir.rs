@@ -168,6 +168,11 @@ impl SweepLayout {
     pub fn figures(&self) -> PathBuf {
         self.0.join("figures")
     }
+
+    /// The HTML report (`index.html`, run pages and their images).
+    pub fn report(&self) -> PathBuf {
+        self.0.join("report")
+    }
 }
 
 /// One row of the training curve.

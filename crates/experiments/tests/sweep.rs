@@ -2,7 +2,8 @@
 //! models, the NOL ablation and the run-time curve of their snapshots): scenes, LBO tables,
 //! runs, eval and every table and figure, with the noise ceiling and the note on unconverged
 //! runs; a second sweep finds every run finished (content addressing); `--emit-jobs` writes
-//! one command per unfinished run.
+//! one command per unfinished run. The built-in smoke profile end to end, with its HTML report
+//! checked (and opened in headless Chromium where installed).
 
 use experiments::sweep::{self, Execution, SweepProfile};
 use std::path::PathBuf;
@@ -146,4 +147,80 @@ fn the_smoke_profile_runs_end_to_end() {
         let mapping = line.trim_end_matches('|').rsplit('|').next().unwrap().trim();
         assert_eq!(mapping.trim_matches('*'), "0.0000", "{line}");
     }
+    // The HTML report: well formed, every link resolves, a page per run, Table 1 ranked with
+    // its noise ceiling.
+    let report = out.join("report");
+    let index = report.join("index.html");
+    let mut pages: Vec<PathBuf> = std::fs::read_dir(report.join("runs"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "html"))
+        .collect();
+    assert_eq!(pages.len(), 74);
+    pages.push(index.clone());
+    for page in &pages {
+        let html = std::fs::read_to_string(page).unwrap();
+        report::html::check_well_formed(&html).unwrap_or_else(|e| panic!("{page:?}: {e}"));
+        for link in report::html::links(&html) {
+            assert!(page.parent().unwrap().join(&link).exists(), "{page:?} links to {link}");
+        }
+    }
+    let html = std::fs::read_to_string(&index).unwrap();
+    assert!(html.contains("Ground truth (noise ceiling)") && html.contains("class=\"best\""));
+    assert!(html.contains("qualitative-") && html.contains("runs/"), "figures and runs linked");
+    browser_check(&index, "smoke-report-index");
+    browser_check(&pages[0], "smoke-report-run");
+}
+
+/// Opens `page` in headless Chromium, when installed (`apt-get install chromium`; or
+/// `NEURAL_BRDF_CHROMIUM` names the binary): every image must load, and a screenshot goes to
+/// `target/tmp/<name>.png`. Without Chromium, says so and returns.
+fn browser_check(page: &std::path::Path, name: &str) {
+    let chromium = std::env::var_os("NEURAL_BRDF_CHROMIUM")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("/usr/bin/chromium"));
+    if !chromium.is_file() {
+        eprintln!("browser check skipped: no Chromium at {}", chromium.display());
+        return;
+    }
+    let profile = test_support::TempDir::new("chromium");
+    let run = |extra: &[String], url: String| {
+        let out = std::process::Command::new(&chromium)
+            .args([
+                "--headless",
+                "--no-sandbox",
+                "--disable-gpu",
+                "--disable-quic",
+                "--no-first-run",
+                "--disable-background-networking",
+                "--disable-component-update",
+                "--disable-sync",
+            ])
+            .arg(format!("--user-data-dir={}", profile.0.display()))
+            .args(extra)
+            .arg(url)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    // Every image of the page loads (a frame inspected by a checker page beside it).
+    let template = include_str!("support/check_images.html");
+    let file = page.file_name().unwrap().to_string_lossy();
+    let checker = page.with_file_name(format!(".check-{file}"));
+    std::fs::write(&checker, template.replace("PAGE", &file)).unwrap();
+    let flags = ["--allow-file-access-from-files", "--virtual-time-budget=20000", "--dump-dom"];
+    let dom = run(&flags.map(String::from), format!("file://{}", checker.display()));
+    std::fs::remove_file(&checker).unwrap();
+    let result = dom
+        .split("<pre id=\"result\">IMAGES ")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no result:\n{dom}"));
+    let (count, broken) = result.split_once(" BROKEN ").unwrap();
+    assert!(count.parse::<usize>().unwrap() > 0, "{result}");
+    assert!(broken.starts_with("[]"), "images that did not load: {broken}");
+    let shot = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}.png"));
+    let flags = ["--window-size=1280,2400".to_string(), format!("--screenshot={}", shot.display())];
+    run(&flags, format!("file://{}", page.display()));
+    assert!(std::fs::metadata(&shot).unwrap().len() > 10_000, "{shot:?}");
 }

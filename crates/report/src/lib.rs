@@ -13,6 +13,7 @@
 //! * [`runtime`]: run time against accuracy (seconds to each model's plateau).
 //! * [`deltas`]: the ablations (NOL, reciprocity options, angle parametrization, NeRFactor
 //!   changes) as differences to the baseline.
+//! * [`html`]: tables and self-contained pages as HTML (the report), with the link checks.
 //! * [`plot`], [`grid`], [`figures`]: line plots (error against training time) and image
 //!   grids (qualitative comparisons, FLIP maps, diffuse / specular / albedo splits), drawn with
 //!   plotters into a [`raster`] with the embedded TTF [`font`] (DejaVu Sans).
@@ -27,6 +28,7 @@ mod error;
 pub mod figures;
 pub mod font;
 pub mod grid;
+pub mod html;
 pub mod latex;
 pub mod markdown;
 pub mod plot;

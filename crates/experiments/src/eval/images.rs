@@ -102,7 +102,7 @@ fn write_exr_rgb(path: &Path, width: usize, height: usize, rgb: &[[f32; 3]]) -> 
 }
 
 /// Writes a linear RGB image as an 8-bit sRGB PNG atomically.
-fn write_png_srgb(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<()> {
+pub(crate) fn write_png_srgb(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<()> {
     Ok(stdx::fs::write_atomic(path, &png_srgb_bytes(path, width, height, rgb)?)?)
 }
 

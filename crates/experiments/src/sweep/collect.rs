@@ -17,6 +17,7 @@
 //! figures/qualitative-<object>.png GT and every model's render with its PSNR, FLIP maps
 //! figures/split-<object>.png       additive models: render, diffuse, specular, albedo
 //! figures/runtime-psnr.png, runtime-rmse.png
+//! report/index.html               the HTML report (see [`super::html_report`])
 //! ```
 
 use super::plan::{self, Purpose};
@@ -238,6 +239,7 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
         runs.iter().filter(|r| r.purposes.iter().any(|p| *p != Purpose::Runtime)).collect();
     let ceiling: Vec<RunRecord> = runs.iter().filter_map(|r| r.ceiling.clone()).collect();
     let mut all_md = String::new();
+    let mut all_tables: Vec<(String, Table)> = Vec::new();
     if !table_runs.is_empty() {
         let rec: Vec<RunRecord> = table_runs.iter().map(|r| r.record.clone()).collect();
         let noise_free: Vec<RunRecord> =
@@ -258,6 +260,7 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
             }
         }
         write_tables(&tables, out, &mut all_md, &mut summary)?;
+        all_tables.extend(tables);
         figures(&runs, out, &mut summary)?;
     }
     let curves: Vec<RunRecord> = runs
@@ -267,7 +270,9 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
         .collect();
     if !curves.is_empty() {
         let t = report::time_to_accuracy(&curves, &ceiling, profile);
-        write_tables(&[("runtime".into(), t)], out, &mut all_md, &mut summary)?;
+        let runtime = [("runtime".to_string(), t)];
+        write_tables(&runtime, out, &mut all_md, &mut summary)?;
+        all_tables.extend(runtime);
         let c = ceiling_psnr(&ceiling, &curves);
         for (metric, name) in [(MetricKind::Psnr, "psnr"), (MetricKind::CubeRootRmse, "rmse")] {
             let reference = if metric == MetricKind::Psnr { c } else { None };
@@ -284,6 +289,7 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
         }
     }
     write(SweepLayout::new(out).tables().join("all.md"), all_md.as_bytes(), &mut summary)?;
+    super::html_report::write_report(out, profile, &all_tables, &runs, &mut summary)?;
     Ok(summary)
 }
 
@@ -482,7 +488,7 @@ fn first_render(run: &Path) -> Option<String> {
     names.first().map(|n| n.trim_end_matches(".exr").to_string())
 }
 
-fn parse_stem(stem: &str) -> Option<(usize, usize)> {
+pub(crate) fn parse_stem(stem: &str) -> Option<(usize, usize)> {
     let rest = stem.strip_prefix("view")?;
     let (v, l) = rest.split_once("_light")?;
     Some((v.parse().ok()?, l.parse().ok()?))

@@ -18,6 +18,7 @@
 
 pub mod collect;
 pub mod execute;
+pub mod html_report;
 pub mod plan;
 pub mod profile;
 
