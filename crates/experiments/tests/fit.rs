@@ -128,6 +128,12 @@ fn models_fit_the_scene_and_eval_scores_them() {
         assert!(test.images == 4 && test.psnr.is_finite() && test.psnr > 15.0, "{kind}: {test:?}");
         assert!(test.flip.is_finite() && test.dssim.is_finite(), "{kind}: {test:?}");
         assert!(test.rmse_cbrt.is_some_and(f64::is_finite) && test.rmse_samples > 0);
+        // Every score carries its settings, from the metric implementations' defaults.
+        let s = test.settings.as_ref().expect("metric settings");
+        assert!(s.images == test.images && s.pixels > 0, "{s:?}");
+        assert!(s.flip.contains("67.02 pixels per degree"), "{}", s.flip);
+        assert!(s.dssim.contains("sigma 1.5") && s.rmse_cbrt.contains("80 degrees"), "{s:?}");
+        assert!(s.image_input.contains("clipped at"), "{}", s.image_input);
         // A semi-synthetic scene: the noise ceiling and the scores against the noise-free
         // renders are there; the ceiling is the same for every model (cached per scene after
         // the first evaluation, identical when recomputed).

@@ -168,6 +168,9 @@ fn the_smoke_profile_runs_end_to_end() {
     let html = std::fs::read_to_string(&index).unwrap();
     assert!(html.contains("Ground truth (noise ceiling)") && html.contains("class=\"best\""));
     assert!(html.contains("qualitative-") && html.contains("runs/"), "figures and runs linked");
+    let run_html = std::fs::read_to_string(&pages[0]).unwrap();
+    assert!(run_html.contains("How the scores were computed"), "metric settings on the run page");
+    assert!(run_html.contains("pixels per degree") && run_html.contains("-curve-steps.png"));
     browser_check(&index, "smoke-report-index");
     browser_check(&pages[0], "smoke-report-run");
 }

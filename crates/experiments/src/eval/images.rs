@@ -94,6 +94,8 @@ pub struct ImageScores {
     pub ceiling: Option<ImageMetrics>,
     /// Test images scored.
     pub images: usize,
+    /// Pixels scored over all test images (the masks' sizes summed).
+    pub pixels: usize,
 }
 
 /// Writes a linear RGB image as an EXR file atomically.
@@ -257,11 +259,13 @@ pub fn render_and_score(
         albedo.write(&out.albedo, (w, h))?;
     }
     let n = t.pairs.len();
+    let pixels = t.pairs.iter().map(|&(vi, _)| dataset.geometry.views[vi].pixels.len()).sum();
     Ok(ImageScores {
         model: model.divided(n),
         clean: clean.map(|c| c.divided(n)),
         ceiling: ceiling.map(|c| c.divided(n)),
         images: n,
+        pixels,
     })
 }
 

@@ -16,6 +16,7 @@
 pub mod analyses;
 pub mod fitted;
 pub mod images;
+pub mod metric_settings;
 pub mod predict;
 pub(crate) mod serde_inf;
 pub mod settings;
@@ -88,6 +89,9 @@ pub struct TestMetrics {
     /// Test scores of the weight snapshots, in step order (runs with `train.snapshots`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub curve: Vec<CurvePoint>,
+    /// The exact settings of every score (absent in runs evaluated before they were recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settings: Option<metric_settings::MetricSettings>,
     /// Wall-clock seconds of the whole evaluation.
     #[serde(default)]
     pub seconds: f64,
@@ -263,6 +267,11 @@ pub fn eval_fitted(
         reciprocity_rmse,
         energy,
         curve,
+        settings: Some(metric_settings::MetricSettings::current(
+            scores.images,
+            scores.pixels,
+            images::clip_level(dataset),
+        )),
         seconds: start.elapsed().as_secs_f64(),
         phases,
     };

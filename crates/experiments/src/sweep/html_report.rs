@@ -4,9 +4,10 @@
 //! ```text
 //! report/index.html              profile and data, Table 1 (with the noise ceiling), every
 //!                                ablation and per-object table, run time, the figures, the runs
-//! report/runs/<run>.html         one run: its settings and metrics.json, training curve, the
-//!                                first test renders beside the observation and the FLIP map
-//! report/runs/<run>-curve.png    its training and validation loss against steps and seconds
+//! report/runs/<run>.html         one run: training curve, the first test renders beside the
+//!                                observation and the FLIP map, how each score was computed
+//!                                (`test.settings`), metrics.json and config.toml
+//! report/runs/<run>-curve-{steps,seconds}.png   training and validation loss against each
 //! report/observed/<object>-<stem>.png   observed test images (sRGB), shared by the run pages
 //! ```
 //!
@@ -252,9 +253,17 @@ fn run_page_html(
         }
         page.figures(&cells);
     }
-    page.heading("metrics.json", "metrics");
     let metrics =
         std::fs::read_to_string(run.metrics()).map_err(|e| Error::io(run.metrics(), e))?;
+    let json: serde_json::Value = serde_json::from_str(&metrics).unwrap_or_default();
+    if let Some(settings) = json.pointer("/test/settings").and_then(|v| v.as_object()) {
+        page.heading("How the scores were computed", "settings");
+        for (key, value) in settings {
+            let text = value.as_str().map_or_else(|| value.to_string(), String::from);
+            page.paragraph(&format!("{key}: {text}"), false);
+        }
+    }
+    page.heading("metrics.json", "metrics");
     page.preformatted(&metrics);
     page.heading("config.toml", "config");
     let config = std::fs::read_to_string(run.config()).map_err(|e| Error::io(run.config(), e))?;
