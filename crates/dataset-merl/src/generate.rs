@@ -85,8 +85,9 @@ fn scene_mesh(config: &SceneConfig) -> Result<TriMesh> {
     Ok(mesh)
 }
 
-/// The material's provenance label and ground truth.
-fn ground_truth(config: &SceneConfig) -> Result<(String, Box<GroundTruth<'static>>)> {
+/// The ground-truth BRDF of a scene's material (local-frame `l`, `v` -> f_r, `None` where the
+/// table is invalid) and its provenance label; captured scenes have none (an error).
+pub fn ground_truth(config: &SceneConfig) -> Result<(String, Box<GroundTruth<'static>>)> {
     match &config.material {
         MaterialSpec::Merl { name } => {
             let m = load_material(name, config.merl_dir.as_deref())?;

@@ -69,8 +69,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let test = eval_fitted(&fitted, &run, false, start)?;
         evals.push((kind, test));
     }
-    println!("\n| model | records | predict | images | reciprocity | energy | curve | total (s) |");
-    println!("| --- |{}", " ---: |".repeat(7));
+    println!(
+        "\n| model | records | predict | images | reciprocity | energy | curve | probe | total (s) |"
+    );
+    println!("| --- |{}", " ---: |".repeat(8));
     for (kind, test) in &evals {
         let cells: Vec<String> =
             test.phases.named().iter().map(|(_, s)| format!("{s:.2}")).collect();

@@ -86,11 +86,13 @@ pub struct EvalPhases {
     pub energy: f64,
     /// The snapshots' test curve.
     pub curve: f64,
+    /// The BRDF plots' probes (lit sphere, slices, albedo, validity maps).
+    pub probe: f64,
 }
 
 impl EvalPhases {
     /// The phases with their names, in order.
-    pub fn named(&self) -> [(&'static str, f64); 6] {
+    pub fn named(&self) -> [(&'static str, f64); 7] {
         [
             ("records", self.records),
             ("predict", self.predict),
@@ -98,6 +100,7 @@ impl EvalPhases {
             ("reciprocity", self.reciprocity),
             ("energy", self.energy),
             ("curve", self.curve),
+            ("probe", self.probe),
         ]
     }
 }

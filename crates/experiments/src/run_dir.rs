@@ -12,6 +12,8 @@
 //! <run>/renders/           eval: per test image EXR + sRGB PNG (+ diffuse/specular parts)
 //! <run>/flip/              eval: HDR-FLIP error map per test image
 //! <run>/albedo/            eval: albedo maps of the additive models
+//! <run>/probe.bin          eval: the model on the BRDF plots' probes (sphere, slices, albedo,
+//!                          validity maps; `eval::probe`)
 //! <run>/run.json           sweep runs only: id, object, dataset, purposes, code version
 //! <run>/sweep.log          sweep runs in child processes: their output
 //!
@@ -90,6 +92,11 @@ impl RunDir {
     /// The albedo maps (additive models).
     pub fn albedo(&self) -> PathBuf {
         self.0.join("albedo")
+    }
+
+    /// `probe.bin`: the model on the BRDF plots' probes.
+    pub fn probe(&self) -> PathBuf {
+        self.0.join("probe.bin")
     }
 
     /// `run.json`: what a sweep knows of the run.

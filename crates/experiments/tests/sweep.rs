@@ -90,6 +90,11 @@ fn a_miniature_sweep_produces_every_table_and_resumes() {
         "figures/qualitative-spot__blue-acrylic.png",
         "figures/split-spot__blue-acrylic.png",
         "figures/runtime-psnr.png",
+        "figures/spheres-spot__blue-acrylic.png",
+        "figures/slices-spot__blue-acrylic.png",
+        "figures/slices-log-spot__blue-acrylic.png",
+        "figures/albedo-spot__blue-acrylic.png",
+        "figures/validity-spot__blue-acrylic.png",
     ] {
         assert!(out.join(f).is_file(), "{f} not written");
     }
@@ -168,6 +173,9 @@ fn the_smoke_profile_runs_end_to_end() {
     let html = std::fs::read_to_string(&index).unwrap();
     assert!(html.contains("Ground truth (noise ceiling)") && html.contains("class=\"best\""));
     assert!(html.contains("qualitative-") && html.contains("runs/"), "figures and runs linked");
+    for f in ["spheres-", "slices-log-", "albedo-", "validity-"] {
+        assert!(html.contains(f), "BRDF plot {f} not in the report");
+    }
     let run_html = std::fs::read_to_string(&pages[0]).unwrap();
     assert!(run_html.contains("How the scores were computed"), "metric settings on the run page");
     assert!(run_html.contains("pixels per degree") && run_html.contains("-curve-steps.png"));

@@ -1,6 +1,7 @@
 //! The paper's figures assembled from records and images: the run-time against error curves
 //! ([`runtime_plot`], drawn by [`super::plot::line_plot_png`]) and the qualitative comparison
-//! grid ([`qualitative_grid`], drawn by [`super::grid::image_grid_png`]).
+//! grid ([`qualitative_grid`]: models in rows, render, FLIP map and a zoom on the highlight
+//! beside the ground truth's, drawn by [`super::grid::image_grid_png`]).
 //!
 //! The diffuse / specular / albedo split figures are plain [`ImageGrid`]s: one row per test
 //! image, columns such as "GT", "render", "diffuse", "specular", "albedo", built with
@@ -103,47 +104,83 @@ pub struct QualitativeRow {
     pub renders: Vec<ModelRender>,
 }
 
-/// The qualitative comparison: one row per test image with the ground truth, then each model's
-/// render captioned with its PSNR; a row whose renders carry FLIP maps is followed by a FLIP row
-/// (an empty ground-truth slot, then each map captioned with the mean FLIP). Column headers
-/// come from the first row's model names.
-pub fn qualitative_grid(title: &str, rows: &[QualitativeRow]) -> ImageGrid {
-    let mut headers = vec!["GT".to_string()];
-    if let Some(first) = rows.first() {
-        headers.extend(first.renders.iter().map(|r| r.model.clone()));
-    }
-    let mut grid_rows = Vec::new();
-    for row in rows {
-        let mut cells = vec![GridCell { image: Some(row.reference.clone()), caption: "GT".into() }];
-        cells.extend(row.renders.iter().map(|r| GridCell {
-            image: Some(r.render.clone()),
-            caption: match r.psnr_db {
-                Score::Value(v) => format!("{} {v:.2} dB", r.model),
-                Score::Unavailable(_) => format!("{} n/a", r.model),
-            },
-        }));
-        grid_rows.push(GridRow { label: row.label.clone(), cells });
-        if row.renders.iter().any(|r| r.flip.is_some()) {
-            let mut cells = vec![GridCell { image: None, caption: String::new() }];
-            cells.extend(row.renders.iter().map(|r| match &r.flip {
-                Some((map, score)) => GridCell {
-                    image: Some(map.clone()),
-                    caption: match score {
-                        Score::Value(v) => format!("FLIP {v:.3}"),
-                        Score::Unavailable(_) => "FLIP n/a".into(),
-                    },
+/// Longest side, in pixels, of every image of [`qualitative_grid`] (renders are enlarged by
+/// whole factors, nearest neighbour, up to it).
+pub const QUALITATIVE_SIDE: u32 = 384;
+
+/// The square window around the brightest ground-truth pixel (the highlight), side a quarter
+/// of the shorter image side (at least 8 pixels): `(x, y, side)`.
+pub fn highlight_window(reference: &RgbImage) -> (u32, u32, u32) {
+    let (w, h) = (reference.width(), reference.height());
+    let side = (w.min(h) / 4).max(8).min(w.min(h));
+    let brightest = reference
+        .pixels()
+        .iter()
+        .enumerate()
+        .max_by_key(|(_, p)| p[0] as u32 + p[1] as u32 + p[2] as u32)
+        .map_or(0, |(i, _)| i as u32);
+    let (cx, cy) = (brightest % w.max(1), brightest / w.max(1));
+    let x = cx.saturating_sub(side / 2).min(w - side);
+    let y = cy.saturating_sub(side / 2).min(h - side);
+    (x, y, side)
+}
+
+/// The qualitative comparison of one test image, laid out to be read: one row per model (the
+/// ground truth first), columns render (captioned with its PSNR), FLIP map (with its mean), and
+/// a zoom on the highlight of the ground truth and of the render side by side (the ground
+/// truth repeated in every row, so each model's highlight sits next to the one it should
+/// match). Images are enlarged to [`QUALITATIVE_SIDE`] by whole factors; text is 22 px.
+pub fn qualitative_grid(title: &str, row: &QualitativeRow) -> ImageGrid {
+    let side = |im: &RgbImage| im.width().max(im.height()).max(1);
+    let full = (QUALITATIVE_SIDE / side(&row.reference)).max(1);
+    let (x, y, win) = highlight_window(&row.reference);
+    let zoom = (QUALITATIVE_SIDE / win.max(1)).max(1);
+    let crop = |im: &RgbImage| GridCell {
+        image: Some(im.crop(x, y, win, win).scaled(zoom)),
+        caption: format!("highlight, {zoom}x"),
+    };
+    let gt_crop = crop(&row.reference);
+    let headers = ["render", "HDR-FLIP", "ground truth (zoom)", "model (zoom)"];
+    let mut rows = vec![GridRow {
+        label: "Ground truth".into(),
+        cells: vec![
+            GridCell { image: Some(row.reference.scaled(full)), caption: row.label.clone() },
+            GridCell { image: None, caption: String::new() },
+            gt_crop.clone(),
+            GridCell { image: None, caption: String::new() },
+        ],
+    }];
+    for r in &row.renders {
+        let psnr = match r.psnr_db {
+            Score::Value(v) => format!("PSNR {v:.2} dB"),
+            Score::Unavailable(_) => "PSNR n/a".into(),
+        };
+        let flip = match &r.flip {
+            Some((map, score)) => GridCell {
+                image: Some(map.scaled(full)),
+                caption: match score {
+                    Score::Value(v) => format!("mean {v:.3}"),
+                    Score::Unavailable(_) => "n/a".into(),
                 },
-                None => GridCell { image: None, caption: "FLIP n/a".into() },
-            }));
-            grid_rows.push(GridRow { label: "FLIP".into(), cells });
-        }
+            },
+            None => GridCell { image: None, caption: "no FLIP map".into() },
+        };
+        rows.push(GridRow {
+            label: r.model.clone(),
+            cells: vec![
+                GridCell { image: Some(r.render.scaled(full)), caption: psnr },
+                flip,
+                gt_crop.clone(),
+                crop(&r.render),
+            ],
+        });
     }
     ImageGrid {
         title: title.to_string(),
-        column_headers: headers,
-        rows: grid_rows,
-        font_px: 16,
-        padding: 8,
+        column_headers: headers.map(String::from).to_vec(),
+        rows,
+        font_px: 22,
+        padding: 10,
     }
 }
 
@@ -183,36 +220,40 @@ mod tests {
     }
 
     #[test]
-    fn qualitative_grid_with_flip_rows() {
-        let img = RgbImage::filled(8, 8, BLACK);
+    fn qualitative_grid_puts_models_in_rows_with_highlight_zooms() {
+        // A 64 x 48 ground truth with its highlight at (50, 10).
+        let mut px = vec![[10u8, 10, 10]; 64 * 48];
+        px[10 * 64 + 50] = [255, 250, 240];
+        let gt = RgbImage::new(64, 48, px).unwrap();
+        assert_eq!(highlight_window(&gt), (44, 4, 12));
         let render = |model: &str, flip| ModelRender {
             model: model.into(),
-            render: img.clone(),
+            render: RgbImage::filled(64, 48, BLACK),
             psnr_db: Score::Value(31.578),
             flip,
         };
-        let rows = vec![
-            QualitativeRow {
-                label: "view 0".into(),
-                reference: img.clone(),
-                renders: vec![
-                    render("Disney", Some((img.clone(), Score::Value(0.1234)))),
-                    render("RP", None),
-                ],
-            },
-            QualitativeRow {
-                label: "view 1".into(),
-                reference: img.clone(),
-                renders: vec![render("Disney", None), render("RP", None)],
-            },
-        ];
-        let g = qualitative_grid("Qualitative", &rows);
-        assert_eq!(g.column_headers, ["GT", "Disney", "RP"]);
-        assert_eq!(g.rows.len(), 3);
-        assert_eq!(g.rows[0].cells[1].caption, "Disney 31.58 dB");
-        assert_eq!(g.rows[1].cells[1].caption, "FLIP 0.123");
-        assert_eq!(g.rows[1].cells[2].caption, "FLIP n/a");
-        assert!(g.rows[1].cells[0].image.is_none());
+        let row = QualitativeRow {
+            label: "view 0, light 3".into(),
+            reference: gt,
+            renders: vec![
+                render("Disney", Some((RgbImage::filled(64, 48, BLACK), Score::Value(0.1234)))),
+                render("RP", None),
+            ],
+        };
+        let g = qualitative_grid("Qualitative", &row);
+        assert_eq!(g.column_headers.len(), 4);
+        let labels: Vec<&str> = g.rows.iter().map(|r| r.label.as_str()).collect();
+        assert_eq!(labels, ["Ground truth", "Disney", "RP"]);
+        // Enlarged 6x (384 / 64) and the 12-pixel highlight window 32x, nearest neighbour.
+        let full = g.rows[1].cells[0].image.as_ref().unwrap();
+        assert_eq!((full.width(), full.height()), (384, 288));
+        let zoom = g.rows[0].cells[2].image.as_ref().unwrap();
+        assert_eq!((zoom.width(), zoom.height()), (384, 384));
+        assert_eq!(zoom.pixels()[(6 * 32) * 384 + 6 * 32], [255, 250, 240]);
+        assert_eq!(g.rows[1].cells[0].caption, "PSNR 31.58 dB");
+        assert_eq!(g.rows[1].cells[1].caption, "mean 0.123");
+        assert_eq!(g.rows[2].cells[1].caption, "no FLIP map");
+        assert_eq!(g.rows[2].cells[2], g.rows[0].cells[2], "ground-truth zoom in every row");
         assert!(image_grid_png(&g).is_ok());
     }
 }

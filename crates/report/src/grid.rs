@@ -85,6 +85,32 @@ impl RgbImage {
     pub fn pixels(&self) -> &[Rgb] {
         &self.pixels
     }
+
+    /// The `w` x `h` region with top-left corner `(x, y)`, clipped to the image.
+    pub fn crop(&self, x: u32, y: u32, w: u32, h: u32) -> RgbImage {
+        let (x, y) = (x.min(self.width), y.min(self.height));
+        let (w, h) = (w.min(self.width - x), h.min(self.height - y));
+        let mut pixels = Vec::with_capacity(w as usize * h as usize);
+        for row in y..y + h {
+            let start = (row * self.width + x) as usize;
+            pixels.extend_from_slice(&self.pixels[start..start + w as usize]);
+        }
+        RgbImage { width: w, height: h, pixels }
+    }
+
+    /// The image enlarged `factor` times with nearest-neighbour sampling (pixels stay visible
+    /// as squares, as a comparison of renders wants).
+    pub fn scaled(&self, factor: u32) -> RgbImage {
+        let f = factor.max(1);
+        let (w, h) = (self.width * f, self.height * f);
+        let mut pixels = Vec::with_capacity(w as usize * h as usize);
+        for row in 0..h {
+            for col in 0..w {
+                pixels.push(self.pixels[((row / f) * self.width + col / f) as usize]);
+            }
+        }
+        RgbImage { width: w, height: h, pixels }
+    }
 }
 
 /// One grid cell: an image (or an empty slot) and its caption ("Disney 31.58 dB").

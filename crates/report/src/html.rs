@@ -24,7 +24,7 @@ p.note{color:#555;font-size:.9em;margin:.2em 0}figure{margin:1em 0}\
 figure img{width:100%;height:auto;border:1px solid #ddd}figcaption{color:#555;font-size:.9em}\
 .grid{display:flex;flex-wrap:wrap;gap:1em}.grid figure{flex:1 1 300px;max-width:420px}\
 pre{background:#f6f6f6;padding:1em;overflow:auto;font-size:.85em}\
-.meta{color:#555}ul.runs{columns:2}";
+.meta{color:#555}ul.runs{columns:2}nav.toc{margin:.5em 0 1.5em;line-height:1.8}";
 
 /// Escapes text for HTML content and attribute values.
 pub fn escape(s: &str) -> String {
@@ -96,17 +96,20 @@ pub fn table_html(table: &Table) -> String {
 pub struct Page {
     title: String,
     body: String,
+    /// (text, id) of every section heading: the contents line of [`Page::finish`].
+    headings: Vec<(String, String)>,
 }
 
 impl Page {
     /// An empty page with a `<title>` and an `<h1>`.
     pub fn new(title: &str) -> Self {
-        Page { title: title.to_string(), body: format!("<h1>{}</h1>\n", escape(title)) }
+        Page { title: title.to_string(), body: String::new(), headings: Vec::new() }
     }
 
     /// A section heading.
     pub fn heading(&mut self, text: &str, id: &str) -> &mut Self {
         let _ = writeln!(self.body, "<h2 id=\"{}\">{}</h2>", escape(id), escape(text));
+        self.headings.push((text.to_string(), id.to_string()));
         self
     }
 
@@ -160,20 +163,36 @@ impl Page {
         self
     }
 
-    /// The complete document.
+    /// The complete document: the title, a contents line linking every section (pages with
+    /// three or more), then the sections.
     pub fn finish(&self) -> String {
+        let mut head = format!("<h1>{}</h1>\n", escape(&self.title));
+        if self.headings.len() >= 3 {
+            head.push_str("<nav class=\"toc\">");
+            for (i, (text, id)) in self.headings.iter().enumerate() {
+                let sep = if i == 0 { "" } else { " · " };
+                let _ = write!(head, "{sep}<a href=\"#{}\">{}</a>", escape(id), escape(text));
+            }
+            head.push_str("</nav>\n");
+        }
         format!(
             "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
              <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-             <title>{}</title>\n<style>{CSS}</style>\n</head>\n<body>\n{}</body>\n</html>\n",
+             <title>{}</title>\n<style>{CSS}</style>\n</head>\n<body>\n{head}{}</body>\n</html>\n",
             escape(&self.title),
             self.body
         )
     }
 }
 
-/// Every `src` and `href` value of a page, unescaped, in order.
+/// Every `src` and `href` value of a page that names a file, unescaped, in order (links
+/// within the page, `#id`, are checked by [`check_well_formed`]).
 pub fn links(html: &str) -> Vec<String> {
+    all_links(html).into_iter().filter(|l| !l.starts_with('#')).collect()
+}
+
+/// Every `src` and `href` value, unescaped, in order.
+fn all_links(html: &str) -> Vec<String> {
     let mut out = Vec::new();
     for attr in ["src=\"", "href=\""] {
         let mut rest = html;
@@ -241,6 +260,13 @@ pub fn check_well_formed(html: &str) -> Result<(), String> {
             return Err(format!("expected exactly one {required}"));
         }
     }
+    for link in all_links(html) {
+        if let Some(id) = link.strip_prefix('#')
+            && !html.contains(&format!("id=\"{}\"", escape(id)))
+        {
+            return Err(format!("links to #{id}, which no element of the page has"));
+        }
+    }
     Ok(())
 }
 
@@ -293,6 +319,17 @@ mod tests {
             links(&html),
             vec!["../figures/a b.png", "c.png", "../figures/a b.png", "c.png", "runs/r&1.html"]
         );
+        assert!(!html.contains("<nav"), "no contents line for one section");
+        let mut q = Page::new("Contents");
+        for (t, id) in [("One", "one"), ("Two", "two"), ("Three", "three")] {
+            q.heading(t, id);
+        }
+        let html = q.finish();
+        check_well_formed(&html).unwrap();
+        assert!(html.contains("<a href=\"#two\">Two</a>"), "{html}");
+        assert!(links(&html).is_empty(), "in-page links are not files");
+        let broken = html.replace("id=\"three\"", "id=\"four\"");
+        assert!(check_well_formed(&broken).unwrap_err().contains("#three"));
         assert!(check_well_formed("<html><head></head><body><p></body></html>").is_err());
         assert!(check_well_formed("<html><head></head><body><p>").is_err());
         assert!(check_well_formed("<html><head></head><body></body>").is_err());

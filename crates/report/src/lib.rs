@@ -13,6 +13,8 @@
 //! * [`runtime`]: run time against accuracy (seconds to each model's plateau).
 //! * [`deltas`]: the ablations (NOL, reciprocity options, angle parametrization, NeRFactor
 //!   changes) as differences to the baseline.
+//! * [`brdf_plots`]: BRDF plots from probes of each model and the ground truth: lit spheres
+//!   with FLIP maps, slices in the plane of incidence, directional albedo, validity maps.
 //! * [`html`]: tables and self-contained pages as HTML (the report), with the link checks.
 //! * [`plot`], [`grid`], [`figures`]: line plots (error against training time) and image
 //!   grids (qualitative comparisons, FLIP maps, diffuse / specular / albedo splits), drawn with
@@ -23,6 +25,7 @@
 //! data and the profile.
 
 pub mod average;
+pub mod brdf_plots;
 pub mod deltas;
 mod error;
 pub mod figures;
@@ -47,7 +50,7 @@ pub use figures::{ModelRender, QualitativeRow, qualitative_grid, runtime_plot};
 pub use grid::{GridCell, GridRow, ImageGrid, RgbImage, image_grid_png};
 pub use latex::{LATEX_PREAMBLE, to_latex};
 pub use markdown::to_markdown;
-pub use plot::{LinePlot, Series, line_plot_png};
+pub use plot::{LegendCorner, LinePlot, Series, line_plot_png};
 pub use record::{Dataset, Direction, MetricKind, RunOptions, RunRecord};
 pub use runtime::time_to_accuracy;
 pub use table::{Cell, Column, ColumnGroup, Marking, Row, Table};

@@ -62,6 +62,25 @@ pub struct LinePlot {
     pub height: u32,
     /// Text size in pixels (default 16).
     pub font_px: u32,
+    /// A marker on every k-th point of a curve (default 1: every point; 0: none), so that
+    /// densely sampled curves stay lines.
+    pub marker_every: usize,
+    /// Corner of the legend (default lower right).
+    pub legend: LegendCorner,
+}
+
+/// Where a plot's legend goes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LegendCorner {
+    /// Upper left.
+    UpperLeft,
+    /// Upper right.
+    UpperRight,
+    /// Lower left.
+    LowerLeft,
+    /// Lower right.
+    #[default]
+    LowerRight,
 }
 
 impl LinePlot {
@@ -81,6 +100,8 @@ impl LinePlot {
             width: 960,
             height: 600,
             font_px: 16,
+            marker_every: 1,
+            legend: LegendCorner::LowerRight,
         }
     }
 }
@@ -230,9 +251,12 @@ where
                     + PathElement::new([(0, 0), (2 * px as i32, 0)], style)
                     + marker(i, (px as i32, 0), radius, c)
             });
-        chart
-            .draw_series(pts.iter().map(|&p| EmptyElement::at(p) + marker(i, (0, 0), radius, c)))
-            .map_err(draw_error)?;
+        if plot.marker_every > 0 {
+            let marked = pts.iter().step_by(plot.marker_every);
+            chart
+                .draw_series(marked.map(|&p| EmptyElement::at(p) + marker(i, (0, 0), radius, c)))
+                .map_err(draw_error)?;
+        }
     }
     if !plot.series.is_empty() || !refs.is_empty() {
         chart
@@ -240,7 +264,12 @@ where
             .label_font(font(px))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
-            .position(SeriesLabelPosition::LowerRight)
+            .position(match plot.legend {
+                LegendCorner::UpperLeft => SeriesLabelPosition::UpperLeft,
+                LegendCorner::UpperRight => SeriesLabelPosition::UpperRight,
+                LegendCorner::LowerLeft => SeriesLabelPosition::LowerLeft,
+                LegendCorner::LowerRight => SeriesLabelPosition::LowerRight,
+            })
             .draw()
             .map_err(draw_error)?;
     }

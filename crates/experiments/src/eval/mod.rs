@@ -5,6 +5,8 @@
 //!   maps and the additive models' diffuse / specular / albedo figures.
 //! * [`analyses`]: energy conservation and the reciprocity RMSE on the test records.
 //! * [`predict`]: the model on CPU records, and as a [`metrics::BatchBrdf`].
+//! * [`probe`]: the model on the BRDF plots' fixed directions (lit sphere, slices, albedo
+//!   against angle, validity maps), stored as `<run>/probe.bin` when images are written.
 //! * [`fitted`]: a finished run opened for analysis (config, model, scene).
 //! * [`settings`]: the `[eval]` table of the run configuration.
 //!
@@ -18,6 +20,7 @@ pub mod fitted;
 pub mod images;
 pub mod metric_settings;
 pub mod predict;
+pub mod probe;
 pub(crate) mod serde_inf;
 pub mod settings;
 
@@ -249,6 +252,12 @@ pub fn eval_fitted(
     charge(&mut phases.reciprocity);
     let energy = analyses::energy(&brdf, &settings, config.seed, progress)?;
     charge(&mut phases.energy);
+    if settings.images
+        && let Some(p) = probe::probe_fitted(&brdf, dataset, &samples, &data)
+    {
+        probe::write(&RunDir::new(run).probe(), &p)?;
+    }
+    charge(&mut phases.probe);
     let path = RunDir::new(run).metrics();
     let mut all = RunMetrics::read(&path)?;
     let curve = snapshot_curve(fitted, run, &all.snapshots, (&samples, &data))?;

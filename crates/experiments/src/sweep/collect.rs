@@ -17,6 +17,8 @@
 //! figures/qualitative-<object>.png GT and every model's render with its PSNR, FLIP maps
 //! figures/split-<object>.png       additive models: render, diffuse, specular, albedo
 //! figures/runtime-psnr.png, runtime-rmse.png
+//! figures/{spheres,slices,slices-log,albedo,validity}-<object>.png   BRDF plots (see
+//!                                  [`super::brdf_figures`])
 //! report/index.html               the HTML report (see [`super::html_report`])
 //! ```
 
@@ -262,6 +264,7 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
         write_tables(&tables, out, &mut all_md, &mut summary)?;
         all_tables.extend(tables);
         figures(&runs, out, &mut summary)?;
+        super::brdf_figures::brdf_figures(&runs, out, &mut summary)?;
     }
     let curves: Vec<RunRecord> = runs
         .iter()
@@ -410,7 +413,7 @@ fn figures(runs: &[CollectedRun], out: &Path, summary: &mut CollectSummary) -> R
             reference: RgbImage::from_linear(&gt),
             renders,
         };
-        let grid = report::qualitative_grid(&format!("{object}: test view {v}, light {l}"), &[row]);
+        let grid = report::qualitative_grid(&format!("{object}: test view {v}, light {l}"), &row);
         write(
             SweepLayout::new(out).figures().join(format!("qualitative-{object}.png")),
             &report::image_grid_png(&grid)?,

@@ -3,7 +3,8 @@
 //!
 //! ```text
 //! report/index.html              profile and data, Table 1 (with the noise ceiling), every
-//!                                ablation and per-object table, run time, the figures, the runs
+//!                                ablation and per-object table, run time, the figures (the
+//!                                qualitative grids, the BRDF plots), the runs
 //! report/runs/<run>.html         one run: training curve, the first test renders beside the
 //!                                observation and the FLIP map, how each score was computed
 //!                                (`test.settings`), metrics.json and config.toml
@@ -115,6 +116,23 @@ pub fn write_report(
     if !qualitative.is_empty() || !split.is_empty() {
         index.heading("Qualitative comparison", "qualitative");
         for f in qualitative.into_iter().chain(split) {
+            index.figures(&[f]);
+        }
+    }
+    let brdf: Vec<(String, String)> = ["spheres-", "slices-", "albedo-", "validity-"]
+        .iter()
+        .flat_map(|p| figures_matching(&dir, summary, p))
+        .collect();
+    if !brdf.is_empty() {
+        index.heading("BRDF plots", "brdf");
+        index.paragraph(
+            "Each fitted model and the ground-truth material away from the cameras' \
+             directions: lit spheres with their HDR-FLIP error, slices in the plane of \
+             incidence (linear and log10), directional albedo against the incident angle \
+             (above 1 the BRDF creates energy), and per-pixel validity on a test view.",
+            true,
+        );
+        for f in brdf {
             index.figures(&[f]);
         }
     }

@@ -5,6 +5,8 @@
 //! * [`execute`]: scene generation, shared LBO tables, runs in-process, as child processes
 //!   (`--jobs`) or as a job file for a cluster (`--emit-jobs`).
 //! * [`collect`]: tables (Markdown + LaTeX) and figures (PNG) from any set of run directories.
+//! * [`brdf_figures`]: the BRDF plots of `collect` (lit spheres, slices, albedo, validity).
+//! * [`html_report`]: the HTML report `collect` writes beside them.
 //!
 //! Layout of a sweep's output directory:
 //!
@@ -16,6 +18,7 @@
 //! <out>/tables/, <out>/figures/      the results (see [`collect`])
 //! ```
 
+pub mod brdf_figures;
 pub mod collect;
 pub mod execute;
 pub mod html_report;
