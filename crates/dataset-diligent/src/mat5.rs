@@ -149,8 +149,8 @@ const MI_MATRIX: u32 = 14;
 const MI_COMPRESSED: u32 = 15;
 const MI_UTF8: u32 = 16;
 
-/// Largest decompressed variable accepted (guards against corrupt length fields).
-const MAX_INFLATED: usize = 1 << 32;
+/// Largest decompressed variable accepted (1 GiB; guards against corrupt length fields).
+const MAX_INFLATED: usize = 1 << 30;
 
 struct Reader<'a> {
     path: &'a Path,
@@ -167,6 +167,38 @@ struct Element<'b> {
 impl Reader<'_> {
     fn fault(&self, fault: impl Into<String>) -> Error {
         Error::Mat { path: self.path.into(), fault: fault.into() }
+    }
+
+    /// Inflates a compressed variable (a zlib stream holding one miMATRIX element) no further
+    /// than the size its own tag declares: the first 8 bytes are inflated alone, and the rest
+    /// is limited to that size (at most [`MAX_INFLATED`]), so a zlib bomb allocates no more
+    /// than its tag admits (and the matrix parser checks that against the declared shape).
+    fn inflate(&self, data: &[u8], at: usize) -> Result<Vec<u8>> {
+        use miniz_oxide::inflate::{TINFLStatus, decompress_to_vec_zlib_with_limit};
+        let fault =
+            |f: String| Error::input(self.path, format!("compressed variable at byte {at}: {f}"));
+        let head = match decompress_to_vec_zlib_with_limit(data, 8) {
+            Ok(v) => v,
+            Err(e) if e.status == TINFLStatus::HasMoreOutput => e.output,
+            Err(e) => return Err(fault(format!("zlib error {:?}", e.status))),
+        };
+        if head.len() < 8 {
+            return Err(fault(format!("{} bytes inflated, no element tag", head.len())));
+        }
+        let declared = self.u32_at(&head, 4)? as usize;
+        let limit = 8 + declared.next_multiple_of(8);
+        if limit > MAX_INFLATED {
+            return Err(fault(format!(
+                "declares {declared} bytes, more than the {MAX_INFLATED} accepted"
+            )));
+        }
+        // The whole stream, checksum included, within the declared size.
+        decompress_to_vec_zlib_with_limit(data, limit).map_err(|e| match e.status {
+            TINFLStatus::HasMoreOutput => fault(format!(
+                "the zlib stream inflates beyond the {declared} bytes its tag declares"
+            )),
+            status => fault(format!("zlib error {status:?}")),
+        })
     }
 
     fn u32_at(&self, b: &[u8], at: usize) -> Result<u32> {
@@ -333,16 +365,7 @@ impl MatFile {
             match el.ty {
                 MI_MATRIX => variables.push(r.matrix(el.data)?),
                 MI_COMPRESSED => {
-                    let inflated = miniz_oxide::inflate::decompress_to_vec_zlib_with_limit(
-                        el.data,
-                        MAX_INFLATED,
-                    )
-                    .map_err(|e| {
-                        fault(format!(
-                            "compressed variable at byte {at}: zlib error {:?}",
-                            e.status
-                        ))
-                    })?;
+                    let inflated = r.inflate(el.data, at)?;
                     let inner = r.element(&inflated, 0)?;
                     if inner.ty != MI_MATRIX {
                         return Err(fault(format!(

@@ -161,7 +161,7 @@ impl RunConfig {
             Error::ConfigParse { path: origin.into(), message: e.to_string() }
         })?;
         config.model.spatial_dim = config.spatial_dim();
-        config.validate()?;
+        config.validate().map_err(|e| e.in_file(origin))?;
         Ok(config)
     }
 

@@ -85,6 +85,18 @@ impl Error {
         Error::Config { key: key.into(), message: message.into() }
     }
 
+    /// A range error of the configuration file `path`, named with it (`path: config key
+    /// \`train.batch_size\`: ...`); other errors are returned as they are.
+    pub fn in_file(self, path: impl Into<PathBuf>) -> Self {
+        match self {
+            Error::Config { key, message } => Error::ConfigParse {
+                path: path.into(),
+                message: format!("config key `{key}`: {message}"),
+            },
+            other => other,
+        }
+    }
+
     /// An I/O error on `path`.
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         Error::Io { path: path.into(), source }

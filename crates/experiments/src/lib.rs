@@ -33,6 +33,8 @@
 
 pub mod checkpoint;
 pub mod config;
+#[cfg(test)]
+mod corrupted_inputs;
 pub mod data;
 pub mod diagnose;
 mod error;

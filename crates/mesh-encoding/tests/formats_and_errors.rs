@@ -248,3 +248,67 @@ fn bad_input_gives_clear_errors() {
     let e = load_mesh(&missing, &LoadOptions::default()).unwrap_err();
     assert!(matches!(e, Error::Io { .. }) && e.to_string().contains("does-not-exist.obj"));
 }
+
+/// No single allocation of a loader may exceed 1 GiB: a header claiming 2^40 elements must be an
+/// error, not an out-of-memory kill.
+#[global_allocator]
+static ALLOC: test_support::corrupt::CappedAlloc = test_support::corrupt::CappedAlloc(1 << 30);
+
+/// Corrupted copies of every format (the fixtures above, and Spot from the shared data where it
+/// is) give an error or a mesh, never a panic or an unbounded allocation.
+#[test]
+fn corrupted_meshes_give_errors_not_panics() {
+    let tmp = common::TempDir::new("fuzz-mesh");
+    let dir = tmp.0.clone();
+    let (bin, json_ext) = gltf_parts(Some("tetra.bin"));
+    write(&dir, "tetra.bin", &bin);
+    let data_uri = format!(
+        "data:application/octet-stream;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&bin)
+    );
+    let (_, json_data) = gltf_parts(Some(&data_uri));
+    let (_, json_glb) = gltf_parts(None);
+    let mut obj = vec![
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4/1/1\nf 1 4 3\nf -1 -2 -3\n".to_vec(),
+    ];
+    if let Some(data) = common::data_dir() {
+        obj.push(std::fs::read(data.join("meshes/spot.obj")).unwrap());
+    }
+    let targets: [(&str, Vec<Vec<u8>>); 4] = [
+        ("obj", obj),
+        ("ply", vec![ply_ascii(&TETRA_P, &tetra_faces()), ply_binary(&TETRA_P, &tetra_faces())]),
+        ("gltf", vec![json_ext.into_bytes(), json_data.into_bytes()]),
+        ("glb", vec![glb(&json_glb, &bin)]),
+    ];
+    for (ext, seeds) in targets {
+        let path = dir.join(format!("fuzz.{ext}"));
+        let cases = if ext == "obj" { 2000 } else { 5000 };
+        test_support::corrupt::fuzz_loader(&format!("mesh-{ext}"), &seeds, cases, |b| {
+            std::fs::write(&path, b).unwrap();
+            let _ = load_mesh(&path, &LoadOptions::default());
+        });
+    }
+}
+
+/// Found by the test above: a glTF whose `accessors` key is misspelt made the gltf crate's
+/// validation index an empty array; and buffer URIs cannot leave the asset's folder.
+#[test]
+fn dangling_gltf_references_and_escaping_uris_are_errors() {
+    let tmp = common::TempDir::new("gltf-refs");
+    let dir = tmp.0.clone();
+    let (bin, json) = gltf_parts(Some("tetra.bin"));
+    write(&dir, "tetra.bin", &bin);
+    let (_, m) =
+        error_of(&dir, "dangling.gltf", json.replace("\"accessors\"", "\"acc0ssors\"").as_bytes());
+    assert!(m.contains("malformed glTF"), "{m}");
+    let sub = dir.join("sub");
+    std::fs::create_dir_all(&sub).unwrap();
+    for uri in ["../tetra.bin", "/etc/hostname", "file:///etc/hostname", "sub/../../tetra.bin"] {
+        let (_, m) = error_of(&sub, "escape.gltf", gltf_parts(Some(uri)).1.as_bytes());
+        assert!(m.contains("outside the asset's folder"), "{uri}: {m}");
+    }
+    // A relative path below the folder is read.
+    write(&sub, "tetra.bin", &bin);
+    let ok = write(&dir, "below.gltf", gltf_parts(Some("./sub/tetra.bin")).1.as_bytes());
+    assert!(load_mesh(&ok, &LoadOptions::default()).is_ok());
+}

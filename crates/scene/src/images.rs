@@ -69,8 +69,29 @@ pub fn exr_rgb_bytes(
     Ok(buf.into_inner())
 }
 
-/// Reads an RGB EXR file: (width, height, row-major pixels). Non-finite values are an error.
+/// Largest EXR layer the reader accepts, in pixels (8192 x 8192, about 800 MB as f32 RGB): the
+/// size comes from the file's header, and a corrupted header must be an error, not an
+/// allocation of its claim.
+pub const MAX_EXR_PIXELS: usize = 8192 * 8192;
+
+/// Reads an RGB EXR file: (width, height, row-major pixels). Non-finite values are an error,
+/// and so is a layer larger than [`MAX_EXR_PIXELS`] (checked from the header before any pixel
+/// buffer is allocated).
 pub fn read_exr_rgb(path: &Path) -> Result<(usize, usize, Vec<[f32; 3]>)> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(&bytes), false)
+        .map_err(|e| image_err(path, e))?;
+    for h in &meta.headers {
+        let (w, hgt) = (h.layer_size.0, h.layer_size.1);
+        if w.checked_mul(hgt).is_none_or(|n| n > MAX_EXR_PIXELS) {
+            return Err(image_err(
+                path,
+                format!(
+                    "the header declares {w} x {hgt} pixels; at most {MAX_EXR_PIXELS} are read"
+                ),
+            ));
+        }
+    }
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
@@ -83,7 +104,7 @@ pub fn read_exr_rgb(path: &Path) -> Result<(usize, usize, Vec<[f32; 3]>)> {
         .first_valid_layer()
         .all_attributes()
         .non_parallel()
-        .from_file(path)
+        .from_buffered(std::io::Cursor::new(bytes))
         .map_err(|e| image_err(path, e))?;
     let size = image.layer_data.size;
     let (_, px) = image.layer_data.channel_data.pixels;
@@ -131,4 +152,28 @@ pub fn write_png_srgb(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) ->
 pub fn png_srgb_bytes(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<Vec<u8>> {
     let bytes: Vec<u8> = rgb.iter().flat_map(|p| p.map(srgb8)).collect();
     encode_png(path, &bytes, width, height, image::ExtendedColorType::Rgb8)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Found by the corrupted-input test: a data window blasted to millions of rows made the reader
+    /// allocate the header's claim before the exr crate looked at the chunks.
+    #[test]
+    fn an_exr_header_claiming_huge_sizes_is_an_error() {
+        let dir = test_support::TempDir::new("exr-header");
+        let path = dir.0.join("huge.exr");
+        let mut bytes = exr_rgb_bytes(&path, 4, 4, &[[0.5; 3]; 16]).unwrap();
+        let at = bytes.windows(17).position(|w| w == b"dataWindow\0box2i\0").unwrap();
+        // After the name and type: size (4), xMin, yMin, xMax (4 each), then yMax.
+        let y_max = at + 17 + 4 + 12;
+        bytes[y_max..y_max + 4].copy_from_slice(&19_999_999i32.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let e = read_exr_rgb(&path).unwrap_err().to_string();
+        assert!(e.contains("huge.exr") && e.contains("declares 4 x 20000000"), "{e}");
+        // The unmodified file still reads.
+        write_exr_rgb(&path, 4, 4, &[[0.5; 3]; 16]).unwrap();
+        assert_eq!(read_exr_rgb(&path).unwrap().2.len(), 16);
+    }
 }

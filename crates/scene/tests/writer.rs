@@ -130,4 +130,49 @@ fn a_written_scene_reads_back_with_its_statistics_and_splits() {
     let names: Vec<_> =
         std::fs::read_dir(&dir.0).unwrap().map(|e| e.unwrap().file_name()).collect();
     assert_eq!(names, ["quad"]);
+    corrupted_scene_files_give_errors_not_panics(&out, &dir.0);
+}
+
+/// No reader may allocate more than 1 GiB at once (a header claiming 2^40 pixels is an error).
+#[global_allocator]
+static ALLOC: test_support::corrupt::CappedAlloc = test_support::corrupt::CappedAlloc(1 << 30);
+
+/// Issue 19: corrupted copies of the written scene's files (manifest, EXR image, flags PNG,
+/// mesh PLY) read through their readers give errors, never a panic.
+fn corrupted_scene_files_give_errors_not_panics(scene: &std::path::Path, tmp: &std::path::Path) {
+    let find = |sub: &str, ext: &str| -> Vec<u8> {
+        let dir = scene.join(sub);
+        let file = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.extension().is_some_and(|e| e == ext))
+            .unwrap_or_else(|| panic!("no .{ext} in {}", dir.display()));
+        std::fs::read(file).unwrap()
+    };
+    let manifest = std::fs::read(scene.join(scene::MANIFEST_FILE)).unwrap();
+    let mesh = std::fs::read_dir(scene)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "ply"))
+        .map(|p| std::fs::read(p).unwrap())
+        .expect("the scene's mesh");
+    let scratch = |name: &str| tmp.join(name);
+    type Reader = fn(&std::path::Path) -> bool;
+    let targets: [(&str, Vec<u8>, &str, Reader); 4] = [
+        ("scene-manifest", manifest, "manifest.json", |p| scene::Manifest::read(p).is_ok()),
+        ("scene-exr", find("images", "exr"), "image.exr", |p| {
+            scene::images::read_exr_rgb(p).is_ok()
+        }),
+        ("scene-flags-png", find("flags", "png"), "flags.png", |p| {
+            scene::images::read_png_gray(p).is_ok()
+        }),
+        ("scene-mesh-ply", mesh, "mesh.ply", |p| scene::mesh_file::load(p).is_ok()),
+    ];
+    for (target, seed, name, reader) in targets {
+        let path = scratch(name);
+        test_support::corrupt::fuzz_loader(target, &[seed], 1500, |b| {
+            std::fs::write(&path, b).unwrap();
+            let _ = reader(&path);
+        });
+    }
 }

@@ -1,7 +1,9 @@
 //! Helpers shared by the tests of every crate (taken as a dev-dependency, never by library code):
-//! where the shared dataset lives ([`shared_data_root`]) and fresh temporary directories
-//! ([`TempDir`]).
+//! where the shared dataset lives ([`shared_data_root`]), fresh temporary directories
+//! ([`TempDir`]), and corrupted copies of real files for the loaders' robustness tests
+//! ([`corrupt`]).
 
+pub mod corrupt;
 mod shared_data;
 mod temp_dir;
 

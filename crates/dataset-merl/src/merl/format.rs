@@ -108,7 +108,8 @@ impl MerlBrdf {
         let dim = |k: usize| i32::from_le_bytes(bytes[4 * k..4 * k + 4].try_into().unwrap());
         let dims = [dim(0), dim(1), dim(2)];
         if dims != [90, 90, 180] {
-            let n = dims.iter().map(|&d| d as i64).product::<i64>();
+            // i128: three i32 factors cannot overflow it (2^24 each overflowed an i64).
+            let n = dims.iter().map(|&d| i128::from(d)).product::<i128>();
             return Err(fault(format!(
                 "dimensions {dims:?} (product {n}); MERL tables are [90, 90, 180]"
             )));

@@ -181,7 +181,7 @@ impl SweepProfile {
             sweep: raw.sweep,
             origin: origin.into(),
         };
-        p.validate()?;
+        p.validate().map_err(|e| e.in_file(origin))?;
         Ok(p)
     }
 

@@ -43,9 +43,12 @@ pub fn read(path: &Path) -> Result<Tensors> {
     let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
     let bad = |reason: &str| Error::WeightFormat { path: path.into(), reason: reason.into() };
     let mut pos = 0usize;
+    // Sizes come from the file: every sum and product is checked, so a header claiming 2^40
+    // elements is "truncated" or an overflow error, never a panic or an allocation.
     let mut take = |n: usize| -> Result<&[u8]> {
-        let s = bytes.get(pos..pos + n).ok_or_else(|| bad("truncated"))?;
-        pos += n;
+        let end = pos.checked_add(n).ok_or_else(|| bad("a size overflows"))?;
+        let s = bytes.get(pos..end).ok_or_else(|| bad("truncated"))?;
+        pos = end;
         Ok(s)
     };
     if take(8)? != MAGIC {
@@ -59,8 +62,11 @@ pub fn read(path: &Path) -> Result<Tensors> {
         let name = String::from_utf8(take(n)?.to_vec()).map_err(|_| bad("name is not UTF-8"))?;
         let rank = u32_at(take(4)?);
         let dims: Vec<usize> = (0..rank).map(|_| take(4).map(u32_at)).collect::<Result<_>>()?;
-        let len: usize = dims.iter().product();
-        let data = take(4 * len)?
+        let bytes_len = dims
+            .iter()
+            .try_fold(4usize, |acc, &d| acc.checked_mul(d))
+            .ok_or_else(|| bad("tensor dimensions overflow"))?;
+        let data = take(bytes_len)?
             .chunks_exact(4)
             .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
             .collect();

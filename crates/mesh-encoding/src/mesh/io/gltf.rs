@@ -21,7 +21,19 @@ use crate::error::MeshFault;
 const MAX_DEPTH: usize = 256;
 
 /// Parses glTF or GLB bytes; `dir` resolves relative buffer URIs.
+///
+/// The gltf crate (1.4.1) panics on some malformed documents during its own validation (an
+/// index into an array the file does not have: found by the corrupted-input test), so a panic
+/// inside it becomes this file's error instead of taking the process down.
 pub(super) fn parse(bytes: &[u8], dir: &Path) -> ParseResult {
+    std::panic::catch_unwind(|| parse_document(bytes, dir)).unwrap_or_else(|_| {
+        Err("malformed glTF: a reference points outside its array (the gltf crate's validation \
+             failed)"
+            .into())
+    })
+}
+
+fn parse_document(bytes: &[u8], dir: &Path) -> ParseResult {
     let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| e.to_string())?;
     let buffers = load_buffers(&gltf, dir)?;
     let doc = &gltf.document;
@@ -77,6 +89,7 @@ fn load_buffers(gltf: &gltf::Gltf, dir: &Path) -> Result<Vec<Vec<u8>>, String> {
                         .decode(b64)
                         .map_err(|e| format!("data URI buffer: {e}"))?
                 } else {
+                    check_relative_uri(uri)?;
                     let file = dir.join(uri);
                     std::fs::read(&file)
                         .map_err(|e| format!("buffer file {}: {e}", file.display()))?
@@ -94,6 +107,27 @@ fn load_buffers(gltf: &gltf::Gltf, dir: &Path) -> Result<Vec<Vec<u8>>, String> {
         buffers.push(data);
     }
     Ok(buffers)
+}
+
+/// A buffer URI must name a file in the asset's folder or below it: no absolute path, no
+/// scheme other than `data:`, no `..` (a downloaded asset cannot make us read elsewhere).
+fn check_relative_uri(uri: &str) -> Result<(), String> {
+    let path = Path::new(uri);
+    let escapes = path.is_absolute()
+        || uri.starts_with('/')
+        || uri.starts_with('\\')
+        || uri.contains(':')
+        || path
+            .components()
+            .any(|c| !matches!(c, std::path::Component::Normal(_) | std::path::Component::CurDir))
+        || uri.split(['/', '\\']).any(|part| part == "..");
+    if escapes {
+        return Err(format!(
+            "buffer URI {uri:?} points outside the asset's folder (absolute, a scheme or ..); \
+             only relative paths below it and data: URIs are read"
+        ));
+    }
+    Ok(())
 }
 
 /// Checks that an accessor is backed by a buffer view large enough for its elements.
