@@ -51,6 +51,17 @@ pub fn reproduce(opts: Options) -> Result<()> {
     let profile =
         SweepProfile::load(&opts.profile)?.with_matmul_precision(opts.matmul_precision)?;
     eprintln!("profile {}: {}", profile.name, profile.description);
+    // One sweep at a time per output directory, held through the tables; taking it removes
+    // the temporary files of a sweep killed in it (run directories busy in another process
+    // keep theirs).
+    let lock = stdx::lock::DirLock::acquire(&opts.out, "reproduce-tables")
+        .context("cannot start the sweep")?;
+    if lock.removed_temporaries > 0 {
+        eprintln!(
+            "removed {} temporary file(s) left by an interrupted run",
+            lock.removed_temporaries
+        );
+    }
     let how = match (&opts.emit_jobs, opts.jobs) {
         (Some(file), _) => {
             Execution::Emit { file: file.clone(), command: run_one_command(opts.backend)? }
@@ -86,7 +97,15 @@ pub fn reproduce(opts: Options) -> Result<()> {
     // The tables of this profile's runs only: an output directory that also holds runs of
     // another profile or of the other `--matmul-precision` keeps them out of these tables
     // (`cargo xtask collect` gathers any set).
-    let c = sweep::collect(&s.runs, &opts.out, &profile.name)?;
+    let c = match sweep::collect(&s.runs, &opts.out, &profile.name) {
+        Err(e) if !s.failed.is_empty() => {
+            anyhow::bail!(
+                "{} run(s) failed (see above), and no table could be made: {e}",
+                s.failed.len()
+            )
+        }
+        c => c?,
+    };
     eprintln!("{} run(s) collected in {:.1} min", c.runs, s.seconds / 60.0);
     print_results(&opts.out, &c.files);
     anyhow::ensure!(
@@ -120,5 +139,6 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<()> {
 
 /// Runs `run-one` (what `--jobs` children and emitted job lines execute).
 pub fn run_one(dir: &Path, progress: bool, backend: Backend) -> Result<()> {
+    sweep::exit_with_parent();
     sweep::run_one(dir, progress, backend).with_context(|| format!("run {}", dir.display()))
 }

@@ -77,6 +77,7 @@ pub mod mlp;
 pub mod model;
 pub mod output;
 pub mod output_init;
+pub mod param_ids;
 pub mod parametric;
 pub mod precision;
 pub mod single_mlp;

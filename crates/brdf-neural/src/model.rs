@@ -263,12 +263,13 @@ impl ModelConfig {
         self.kind.analytic().is_none()
     }
 
-    /// Builds the model on `device` (use an autodiff device for training).
+    /// Builds the model on `device` (use an autodiff device for training), its parameter ids
+    /// numbered deterministically ([`crate::param_ids`]).
     pub fn init(&self, device: &Device) -> Result<BrdfModel> {
         self.validate()?;
         let mut mlps = self.mlp_configs().into_iter().map(|m| m.init(device));
         let mut next = || mlps.next().expect("MLP count");
-        Ok(match self.kind {
+        Ok(crate::param_ids::deterministic_ids(match self.kind {
             k if k.analytic().is_some() => BrdfModel::Parametric(ParametricModel::new(
                 next(),
                 k.analytic().expect("parametric"),
@@ -286,7 +287,7 @@ impl ModelConfig {
                 let (t, d, s) = (next(), next(), next());
                 BrdfModel::AdditiveShared(AdditiveShared::new(t, d, s, self.additive_head()))
             }
-        })
+        }))
     }
 }
 

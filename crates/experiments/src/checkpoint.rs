@@ -55,9 +55,9 @@ pub fn save(
             .clone()
             .save_file(tmp.join(MODEL))
             .map_err(|e| Error::format(tmp.join(MODEL), format!("cannot write weights: {e:?}")))?;
-        optim.save(tmp.join(OPTIM)).map_err(|e| {
-            Error::format(tmp.join(OPTIM), format!("cannot write Adam state: {e:?}"))
-        })?;
+        let adam = canonical_optimizer_bytes(optim)
+            .map_err(|e| Error::format(tmp.join(OPTIM), format!("cannot write Adam state: {e}")))?;
+        std::fs::write(tmp.join(OPTIM), adam).map_err(|e| Error::io(tmp.join(OPTIM), e))?;
         let json = serde_json::to_string(state).map_err(|e| Error::format(tmp, e.to_string()))?;
         std::fs::write(tmp.join(STATE), json).map_err(|e| Error::io(tmp.join(STATE), e))
     })?;
@@ -67,6 +67,25 @@ pub fn save(
         }
     }
     Ok(dir)
+}
+
+/// Adam's state as a burnpack with its tensors in name order. burn lists them in the order of
+/// a `HashMap`, which differs from process to process, so the same state would be written as
+/// different bytes and a resumed run's checkpoint would not equal an uninterrupted one's.
+fn canonical_optimizer_bytes(optim: &ModuleOptimizer) -> std::result::Result<Vec<u8>, String> {
+    let bytes = optim.into_bytes().map_err(|e| format!("{e:?}"))?;
+    let reader = burn_pack::Reader::from_bytes(bytes).map_err(|e| format!("{e:?}"))?;
+    let (scalars, metadata) = (reader.scalars().clone(), reader.metadata().clone());
+    let mut tensors = reader.into_tensors().map_err(|e| format!("{e:?}"))?;
+    tensors.sort_by(|a, b| a.name.cmp(&b.name));
+    let mut writer = burn_pack::Writer::new(tensors);
+    for (key, value) in &scalars {
+        writer = writer.with_scalar(key, *value);
+    }
+    for (key, value) in &metadata {
+        writer = writer.with_metadata(key, value);
+    }
+    Ok(writer.into_bytes().map_err(|e| format!("{e:?}"))?.to_vec())
 }
 
 /// Complete checkpoints of a run, oldest first.

@@ -189,7 +189,16 @@ pub fn fit_and_keep(
     options: FitOptions,
 ) -> Result<(FitOutcome, Option<Trained>)> {
     config.validate()?;
-    std::fs::create_dir_all(run).map_err(|e| Error::io(run, e))?;
+    // One process at a time in a run directory; taking the lock removes the temporaries of a
+    // process killed in it.
+    let lock = stdx::lock::DirLock::acquire(run, "training")?;
+    if lock.removed_temporaries > 0 {
+        eprintln!(
+            "{}: removed {} temporary file(s) of an interrupted write",
+            run.display(),
+            lock.removed_temporaries
+        );
+    }
     let dir = RunDir::new(run);
     if let Some(metrics) = prepare_run_dir(config, &dir, options.config_from_run_dir)? {
         return Ok((FitOutcome::AlreadyFinished(metrics), None));

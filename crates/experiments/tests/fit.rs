@@ -204,6 +204,23 @@ fn runs_are_deterministic_and_resume_is_exact() {
     };
     assert_eq!(strip_time(curve(&a)), strip_time(curve(&r)), "validation losses too");
     assert!(curve(&a).starts_with("step,loss,val_loss,lr,wall_seconds\n"));
+    // The files themselves are equal byte for byte: weights, and the last checkpoint's weights
+    // and Adam state (burn's random parameter ids and hash-ordered optimizer tensors are made
+    // deterministic).
+    let bytes = |run: &Path, rel: &str| std::fs::read(run.join(rel)).unwrap();
+    for rel in [
+        "weights.bpk",
+        "checkpoints/step-000000060/model.bpk",
+        "checkpoints/step-000000060/optim.bpk",
+    ] {
+        assert!(bytes(&a, rel) == bytes(&b, rel), "{rel}: two fits differ");
+        assert!(bytes(&a, rel) == bytes(&r, rel), "{rel}: the resumed fit differs");
+    }
+    // A run directory another process works in is refused, naming that process.
+    let busy = stdx::lock::DirLock::acquire(&r, "a test").unwrap();
+    let msg = fit(&c, &r, FitOptions::default()).unwrap_err().to_string();
+    assert!(msg.contains("in use by process") && msg.contains("(a test)"), "{msg}");
+    drop(busy);
     // A different configuration in the same run directory is refused.
     let other = config("single_mlp", 61, "validate_every = 10\npatience = 20\n");
     let msg = fit(&other, &r, FitOptions::default()).unwrap_err().to_string();

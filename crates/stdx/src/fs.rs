@@ -1,8 +1,14 @@
-//! Atomic writes: a file ([`write_atomic`], [`write_atomic_with`]) or a whole directory
+//! Atomic, durable writes: a file ([`write_atomic`], [`write_atomic_with`]) or a whole directory
 //! ([`write_dir_atomic`]) is assembled under a temporary name beside its destination, flushed to
-//! disk, then renamed into place, so a reader (or a run killed half-way) never sees a
+//! disk (every file, and every folder of a directory), renamed into place, and then the folder
+//! holding it is flushed too, so a reader, a run killed half-way or a power cut never sees a
 //! half-written one. The temporary files come from `tempfile` (unique names, removed on every
 //! error path) and get the permissions an ordinary `File::create` would (the umask applies).
+//!
+//! Every temporary name starts with `.` and contains `.tmp-` or `.partial-`
+//! ([`is_temporary`]); a process killed between creating one and renaming it leaves it behind,
+//! and the next process that takes the folder's lock ([`crate::lock`]) removes it
+//! ([`remove_temporaries`]).
 //!
 //! Every error names the path it concerns ([`Error`]); each crate converts it into its own error
 //! type with a `From` impl.
@@ -64,17 +70,87 @@ fn builder<'a>(prefix: &'a str, dir: bool) -> tempfile::Builder<'a, 'static> {
     b
 }
 
-/// Writes `bytes` to `path` atomically, creating the parent directory if needed.
+/// Whether a file name is one of this module's temporary names (a leftover of a killed
+/// process once nobody holds the folder's lock).
+pub fn is_temporary(name: &str) -> bool {
+    name.starts_with('.') && (name.contains(".tmp-") || name.contains(".partial-"))
+}
+
+/// Flushes a directory's entries (a rename or a new file in it) to disk.
+pub fn sync_dir(dir: &Path) -> Result<(), Error> {
+    #[cfg(unix)]
+    std::fs::File::open(dir).and_then(|f| f.sync_all()).map_err(|e| Error::new(dir, e))?;
+    #[cfg(not(unix))]
+    let _ = dir;
+    Ok(())
+}
+
+/// Flushes every file and folder under `dir` (and `dir` itself) to disk.
+fn sync_tree(dir: &Path) -> Result<(), Error> {
+    for entry in std::fs::read_dir(dir).map_err(|e| Error::new(dir, e))? {
+        let entry = entry.map_err(|e| Error::new(dir, e))?;
+        let path = entry.path();
+        let kind = entry.file_type().map_err(|e| Error::new(&path, e))?;
+        if kind.is_dir() {
+            sync_tree(&path)?;
+        } else if kind.is_file() {
+            std::fs::File::open(&path)
+                .and_then(|f| f.sync_all())
+                .map_err(|e| Error::new(&path, e))?;
+        }
+    }
+    sync_dir(dir)
+}
+
+/// Removes the temporary files and folders ([`is_temporary`]) under `root`, at any depth
+/// (symbolic links are not followed); returns how many were removed. Call it only while holding
+/// `root`'s lock: a temporary of a live writer would be pulled from under it.
+pub fn remove_temporaries(root: &Path) -> Result<usize, Error> {
+    remove_temporaries_except(root, &|_| false)
+}
+
+/// [`remove_temporaries`], leaving alone the folders (and all below them) for which `skip` is
+/// true (the folders another live process holds the lock of).
+pub fn remove_temporaries_except(
+    root: &Path,
+    skip: &dyn Fn(&Path) -> bool,
+) -> Result<usize, Error> {
+    let entries = match std::fs::read_dir(root) {
+        Ok(e) => e,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(0),
+        Err(e) => return Err(Error::new(root, e)),
+    };
+    let mut removed = 0;
+    for entry in entries {
+        let entry = entry.map_err(|e| Error::new(root, e))?;
+        let path = entry.path();
+        let kind = entry.file_type().map_err(|e| Error::new(&path, e))?;
+        if is_temporary(&entry.file_name().to_string_lossy()) {
+            let r = if kind.is_dir() {
+                std::fs::remove_dir_all(&path)
+            } else {
+                std::fs::remove_file(&path)
+            };
+            r.map_err(|e| Error::new(&path, e))?;
+            removed += 1;
+        } else if kind.is_dir() && !skip(&path) {
+            removed += remove_temporaries_except(&path, skip)?;
+        }
+    }
+    Ok(removed)
+}
+
+/// Writes `bytes` to `path` atomically and durably, creating the parent directory if needed.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     let dir = parent_dir(path);
     std::fs::create_dir_all(dir).map_err(|e| Error::new(dir, e))?;
-    let prefix = format!(".{}.", file_name(path, "file"));
+    let prefix = format!(".{}.tmp-", file_name(path, "file"));
     let mut file = builder(&prefix, false).tempfile_in(dir).map_err(|e| Error::new(dir, e))?;
     file.write_all(bytes)
         .and_then(|()| file.as_file().sync_all())
         .map_err(|e| Error::new(file.path(), e))?;
     file.persist(path).map_err(|e| Error::new(path, e.error))?;
-    Ok(())
+    sync_dir(dir)
 }
 
 /// Writes `path` atomically through a writer that wants a path of its own (burn's record
@@ -92,7 +168,8 @@ pub fn write_atomic_with<E: From<Error>>(
     let tmp = dir.join(format!(".tmp-{}-{n}-{}", std::process::id(), file_name(path, "file")));
     let result = write(&tmp).and_then(|()| {
         std::fs::File::open(&tmp).and_then(|f| f.sync_all()).map_err(|e| Error::new(&tmp, e))?;
-        std::fs::rename(&tmp, path).map_err(|e| Error::new(path, e).into())
+        std::fs::rename(&tmp, path).map_err(|e| Error::new(path, e))?;
+        sync_dir(dir).map_err(E::from)
     });
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
@@ -101,8 +178,10 @@ pub fn write_atomic_with<E: From<Error>>(
 }
 
 /// Builds the directory `out` atomically: `build` fills a fresh temporary sibling of `out`
-/// (with `subdirs` created), which then replaces `out`. On an error the temporary directory is
-/// removed and `out` is left as it was.
+/// (with `subdirs` created), which is flushed to disk whole and then replaces `out`. On an error
+/// the temporary directory is removed and `out` is left as it was. (Replacing an existing `out`
+/// takes two renames' time during which neither is in place; a reader treats a missing `out` as
+/// not yet written.)
 pub fn write_dir_atomic<T, E: From<Error>>(
     out: &Path,
     subdirs: &[&str],
@@ -118,16 +197,39 @@ pub fn write_dir_atomic<T, E: From<Error>>(
     }
     // On an error `tmp` is dropped here, which removes it.
     let value = build(tmp.path())?;
+    sync_tree(tmp.path())?;
     let tmp = tmp.keep();
-    let replace = || -> Result<(), Error> {
-        if out.exists() {
-            std::fs::remove_dir_all(out).map_err(|e| Error::new(out, e))?;
+    // The old directory is first renamed aside under a temporary name (one atomic step), so a
+    // kill at any moment leaves either the old or the new one whole at `out`, or neither (and
+    // the old one under a temporary name, removed by the next `remove_temporaries`), never a
+    // half-deleted one.
+    let aside = parent.join(format!(
+        "{prefix}old-{}",
+        tmp.file_name()
+            .map_or_else(|| std::process::id().to_string(), |n| n.to_string_lossy().into_owned(),)
+    ));
+    let replace = || -> Result<bool, Error> {
+        let had_old = out.exists();
+        if had_old {
+            std::fs::rename(out, &aside).map_err(|e| Error::new(out, e))?;
         }
-        std::fs::rename(&tmp, out).map_err(|e| Error::new(out, e))
+        std::fs::rename(&tmp, out).map_err(|e| Error::new(out, e))?;
+        Ok(had_old)
     };
-    if let Err(e) = replace() {
-        let _ = std::fs::remove_dir_all(&tmp);
-        return Err(e.into());
+    match replace() {
+        Ok(had_old) => {
+            sync_dir(parent)?;
+            if had_old {
+                std::fs::remove_dir_all(&aside).map_err(|e| Error::new(&aside, e))?;
+            }
+        }
+        Err(e) => {
+            let _ = std::fs::remove_dir_all(&tmp);
+            if aside.exists() && !out.exists() {
+                let _ = std::fs::rename(&aside, out);
+            }
+            return Err(e.into());
+        }
     }
     Ok(value)
 }

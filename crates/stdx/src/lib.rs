@@ -1,6 +1,8 @@
 //! The workspace's small shared utilities, one home for each (after rust-analyzer's `stdx`):
 //!
-//! - [`fs`]: atomic writes of a file or a whole directory (a reader never sees a half-written one);
+//! - [`fs`]: atomic, durable writes of a file or a whole directory (a reader never sees a
+//!   half-written one), and the removal of a killed writer's temporaries;
+//! - [`lock`]: exclusive folder locks (one process at a time in a run directory or a sweep);
 //! - [`rng`]: SplitMix64, the seeded generator behind every reproducible stream that is not a
 //!   `rand` one (orbit cameras, sensor noise, light splits, Lanczos start blocks, Monte Carlo);
 //! - [`progress`]: the progress-bar styles of every long step;
@@ -15,6 +17,8 @@
 pub mod cache_file;
 #[cfg(feature = "fs")]
 pub mod fs;
+#[cfg(feature = "fs")]
+pub mod lock;
 #[cfg(feature = "progress")]
 pub mod progress;
 pub mod rng;

@@ -210,6 +210,7 @@ pub fn eval_fitted(
     progress: bool,
     start: Instant,
 ) -> Result<TestMetrics> {
+    let _lock = stdx::lock::DirLock::acquire(run, "evaluating")?;
     let (config, device, model, dataset) =
         (&fitted.config, &fitted.device, &fitted.model, &fitted.dataset);
     let settings = config.eval.resolve(config.train.profile);

@@ -65,6 +65,32 @@ pub struct SweepSummary {
     pub seconds: f64,
 }
 
+/// The environment variable through which a `--jobs` child learns its parent's process id.
+pub const PARENT_PID_VAR: &str = "NEURAL_BRDF_SWEEP_PID";
+
+/// In a `--jobs` child (one started with [`PARENT_PID_VAR`] set): ends this process within half
+/// a second of its parent sweep's end, even a SIGKILL, so that killing a sweep stops its runs
+/// (their files are written atomically and resume from the last checkpoint). Does nothing in
+/// any other process.
+pub fn exit_with_parent() {
+    #[cfg(unix)]
+    {
+        let Some(parent) = std::env::var(PARENT_PID_VAR).ok().and_then(|v| v.parse::<u32>().ok())
+        else {
+            return;
+        };
+        std::thread::spawn(move || {
+            loop {
+                if std::os::unix::process::parent_id() != parent {
+                    eprintln!("the sweep (process {parent}) has ended: stopping this run");
+                    std::process::exit(143);
+                }
+                std::thread::sleep(std::time::Duration::from_millis(250));
+            }
+        });
+    }
+}
+
 /// Whether a run directory holds an evaluated run.
 pub fn is_done(run: &Path) -> bool {
     RunDir::new(run).is_evaluated()
@@ -225,6 +251,7 @@ pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) ->
                     let err = file.try_clone().map_err(|e| Error::io(&log, e))?;
                     let child = Command::new(program)
                         .args(args)
+                        .env(PARENT_PID_VAR, std::process::id().to_string())
                         .arg(d.as_path())
                         .stdout(file)
                         .stderr(err)
@@ -245,9 +272,10 @@ pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) ->
                         if status.success() && is_done(&d) {
                             summary.completed += 1;
                         } else {
+                            let log = RunDir::new(&d).log();
                             summary.failed.push((
                                 d.clone(),
-                                format!("{status}; see {}", RunDir::new(&d).log().display()),
+                                format!("{status}: {}; see {}", last_error(&log), log.display()),
                             ));
                         }
                         bar.inc(1);
@@ -273,6 +301,24 @@ pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) ->
     }
     bar.finish_and_clear();
     Ok(())
+}
+
+/// The error a child printed last (the lines from its last `Error:` on, joined), or a note that
+/// its log has none (a child killed by a signal).
+fn last_error(log: &Path) -> String {
+    let text = std::fs::read_to_string(log).unwrap_or_default();
+    let lines: Vec<&str> = text.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+    match lines.iter().rposition(|l| l.starts_with("Error:")) {
+        Some(i) => lines[i..]
+            .iter()
+            .filter(|l| *l != &"Caused by:" && !l.starts_with("Stack backtrace"))
+            .take(6)
+            .copied()
+            .collect::<Vec<_>>()
+            .join(" / "),
+        None if lines.is_empty() => "its log is empty (a full disk, or killed)".into(),
+        None => "no error message in its log (killed?)".into(),
+    }
 }
 
 fn short(d: &Path) -> String {

@@ -26,5 +26,5 @@ pub mod plan;
 pub mod profile;
 
 pub use collect::{CollectSummary, collect};
-pub use execute::{Execution, SweepSummary, run_one, sweep};
+pub use execute::{Execution, SweepSummary, exit_with_parent, run_one, sweep};
 pub use profile::{DEFAULT_PROFILE, SweepProfile};
