@@ -86,6 +86,12 @@ impl<T: Real> Default for DisneyParams<T> {
 /// Lower bound on n.l + n.v in the subsurface term's 1 / (n.l + n.v), which diverges at grazing.
 const MIN_COS_SUM: f64 = 1e-12;
 
+/// The base colour's luminance at or below which the tint colour is white (the reference
+/// shader's `Cdlum > 0 ? Cdlin / Cdlum : 1`, with the test moved from 0 to this small floor: the
+/// tensor twin divides by the luminance, and the derivative of x / y squares y, which underflows
+/// f32 to 0 for y below ~1e-19 and turned the gradients of a near-black base colour into NaN).
+pub const TINT_LUMINANCE_MIN: f64 = 1e-15;
+
 /// The isotropic Disney BRDF (Burley 2012, "Physically-Based Shading at Disney"; reference
 /// shader wdas/brdf `disney.brdf`; spec section 3.3). With FL, FV, FH = (1 - cos)^5 of n.l, n.v, l.h:
 ///
@@ -140,7 +146,8 @@ impl<T: Real> Disney<T> {
             p.base_color
         };
         let cdlum = T::lit(0.3) * cdlin[0] + T::lit(0.6) * cdlin[1] + T::lit(0.1) * cdlin[2];
-        let ctint = if cdlum > T::zero() { cdlin.map(|x| x / cdlum) } else { [one; 3] };
+        let ctint =
+            if cdlum > T::lit(TINT_LUMINANCE_MIN) { cdlin.map(|x| x / cdlum) } else { [one; 3] };
         let dielectric = T::lit(0.5) * T::lit(0.16) * p.specular; // specular * 0.08
         let cspec0 = [0, 1, 2]
             .map(|i| mix(dielectric * mix(one, ctint[i], p.specular_tint), cdlin[i], p.metallic));

@@ -75,7 +75,7 @@ pub use batch::eval_batch;
 #[cfg(feature = "rayon")]
 pub use batch::par_eval_batch;
 pub use brdf::{Brdf, BrdfSample, Rgb};
-pub use disney::{Disney, DisneyParams};
+pub use disney::{Disney, DisneyParams, TINT_LUMINANCE_MIN as DISNEY_TINT_LUMINANCE_MIN};
 /// FMBRDF's frame helpers, shared with its tensor twin: the body network's input features
 /// (view-aligned frame of the addendum) and the clamped tan(theta) of the Smith network.
 pub use fmbrdf::geometry::{body_features as fmbrdf_body_features, smith_tan as fmbrdf_smith_tan};

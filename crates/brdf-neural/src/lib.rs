@@ -72,6 +72,7 @@ pub mod batch;
 pub mod device;
 mod error;
 pub mod features;
+pub mod finite_check;
 pub mod host_memory;
 pub mod mlp;
 pub mod model;

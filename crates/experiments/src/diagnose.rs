@@ -1,5 +1,5 @@
-//! Which parameter group of a model holds non-finite (or the largest) values: the message a
-//! non-finite loss stops the run with.
+//! Which parameter group of a model holds non-finite (or the largest) values, and which input of
+//! the batch made the outputs go bad: the message a non-finite loss stops the run with.
 
 use brdf_neural::BrdfModel;
 use burn::module::{Module, ModuleVisitor, Param};
@@ -79,4 +79,36 @@ pub fn diagnose(model: &BrdfModel) -> String {
 /// Whether every parameter of `model` is finite.
 pub fn all_finite(model: &BrdfModel) -> bool {
     param_health(model).iter().all(|h| h.non_finite == 0)
+}
+
+/// The batch's worst input: the first row whose output (f, or an additive model's part) is not
+/// finite, else the row with the largest f, with its directions and the size of its features.
+pub fn worst_input(out: &brdf_neural::BrdfOutput, inputs: &brdf_neural::Samples) -> String {
+    let (what, row) = match brdf_neural::finite_check::first_bad_output(out) {
+        Some(p) => (p.to_string(), p.row.unwrap_or(0)),
+        None => {
+            let f: Vec<f32> =
+                out.f.clone().into_data().convert::<f32>().try_to_vec::<f32>().unwrap_or_default();
+            let (i, max) = f
+                .iter()
+                .copied()
+                .enumerate()
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+                .unwrap_or((0, 0.0));
+            let row = i / 3;
+            (format!("outputs finite, largest f = {max:e} at batch row {row}"), row)
+        }
+    };
+    let (Some(l), Some(v)) = (inputs.l.get(row), inputs.v.get(row)) else {
+        return format!("the batch's worst input: {what}");
+    };
+    let dim = inputs.spatial.len() / inputs.l.len().max(1);
+    let features = inputs.spatial.get(row * dim..(row + 1) * dim).unwrap_or(&[]);
+    let max_abs =
+        features.iter().fold(0.0_f32, |m, x| if x.is_nan() { f32::NAN } else { m.max(x.abs()) });
+    format!(
+        "the batch's worst input: {what}: l = {l:?}, v = {v:?} (n.l = {:.3e}, n.v = {:.3e}), \
+         largest feature magnitude {max_abs:e}",
+        l[2], v[2]
+    )
 }

@@ -9,7 +9,7 @@
 use crate::checkpoint::{self, CheckpointState};
 use crate::config::RunConfig;
 use crate::data::TrainingData;
-use crate::diagnose::{all_finite, diagnose};
+use crate::diagnose::{all_finite, diagnose, worst_input};
 use crate::loss::{LossWeights, loss, srgb_oetf};
 use crate::plateau::{Decision, StopReason};
 use crate::profile::{Phase, PhaseTimer};
@@ -160,10 +160,11 @@ impl Loop<'_> {
         timer.charge(Phase::Loss);
         if !value.is_finite() {
             self.bar.abandon();
+            let input = worst_input(&out, &samples);
             return Err(Error::NonFinite {
                 step,
                 loss: value,
-                diagnosis: diagnose(&model),
+                diagnosis: format!("{}; {input}", diagnose(&model)),
                 checkpoint: last_checkpoint.clone(),
             });
         }

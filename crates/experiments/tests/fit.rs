@@ -285,6 +285,7 @@ fn a_non_finite_loss_stops_the_run_and_keeps_the_last_checkpoint() {
         "{msg}"
     );
     assert!(msg.contains("step-000000020"), "{msg}");
+    assert!(msg.contains("the batch's worst input: output f = NaN at batch row 0: l = ["), "{msg}");
     assert!(run.join("checkpoints/step-000000020/model.bpk").is_file());
     assert!(!RunDir::new(&run).weights().exists());
 }

@@ -1,8 +1,10 @@
 //! Helpers shared by the tests of every crate (taken as a dev-dependency, never by library code):
 //! where the shared dataset lives ([`shared_data_root`]), fresh temporary directories
-//! ([`TempDir`]), and corrupted copies of real files for the loaders' robustness tests
-//! ([`corrupt`]).
+//! ([`TempDir`]), corrupted copies of real files for the loaders' robustness tests
+//! ([`corrupt`]), and adversarial directions and features for the numerics stress tests
+//! ([`adversarial`]).
 
+pub mod adversarial;
 pub mod corrupt;
 mod shared_data;
 mod temp_dir;

@@ -56,7 +56,11 @@ pub fn disney(p: &DisneyTensorParams, g: &Geometry) -> Tensor<2> {
     };
     let ch = |k: usize| cdlin.clone().narrow(1, k, 1);
     let cdlum = ch(0).mul_scalar(0.3) + ch(1).mul_scalar(0.6) + ch(2).mul_scalar(0.1);
-    let ctint = cdlin.clone() / cdlum.clamp_min(1e-30);
+    // White where the luminance is (near) zero, like the scalar twin; the division's floor keeps
+    // its derivative (which squares the luminance) finite in f32.
+    let floor = brdf_analytic::DISNEY_TINT_LUMINANCE_MIN as f32;
+    let dark = cdlum.clone().lower_equal_elem(floor).repeat_dim(1, 3);
+    let ctint = (cdlin.clone() / cdlum.clamp_min(floor)).mask_fill(dark, 1.0);
     let dielectric = p.specular.clone().mul_scalar(0.5 * 0.16);
     let cspec0 = mix(
         dielectric * mix_one(ctint.clone(), p.specular_tint.clone()),
