@@ -65,7 +65,7 @@ enum Command {
         /// Lights per view (30 of 42 train by default, the same fraction otherwise).
         #[arg(long, default_value_t = 42)]
         lights: usize,
-        /// Directory with real MERL binaries (<name>.binary), which take precedence.
+        /// Directory with real MERL binaries (`<name>.binary`), which take precedence.
         #[arg(long)]
         merl_dir: Option<PathBuf>,
         /// Output directory.

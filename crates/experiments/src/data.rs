@@ -363,6 +363,12 @@ pub fn lbo_encoding(
     std::fs::create_dir_all(cache_dir).map_err(|e| Error::io(cache_dir, e))?;
     let k = config.required_pairs();
     let settings = eigen_settings(features);
-    let (pairs, _) = cached_eigenpairs(&vertices, &scene.mesh.triangles, k, &settings, cache_dir)?;
+    let mesh = scene.dir.join(&scene.manifest.mesh_file);
+    let (pairs, _) = cached_eigenpairs(&vertices, &scene.mesh.triangles, k, &settings, cache_dir)
+        .map_err(|e| match e {
+        // Name the mesh a failed solve (a mesh too large for memory, say) is about.
+        mesh_encoding::Error::Lbo { .. } => Error::format(&mesh, e.to_string()),
+        e => e.into(),
+    })?;
     Ok(LboEncoding::new(&pairs, &config)?)
 }

@@ -2,7 +2,7 @@
 //! the curve, snapshots and checkpoints.
 //!
 //! The loop's inputs that never change (configuration, records, devices, run directory,
-//! progress bar) live in [`Loop`]; what changes (model, optimiser, [`CheckpointState`]) is
+//! progress bar) live in `Loop`; what changes (model, optimiser, [`CheckpointState`]) is
 //! passed through it explicitly, so every step is a function of (state, step) and a resumed
 //! run repeats an uninterrupted one exactly.
 

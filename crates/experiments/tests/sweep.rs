@@ -53,7 +53,8 @@ runtime_curve = true
 fn a_miniature_sweep_produces_every_table_and_resumes() {
     let Some(data) = shared_data() else { return };
     let tmp = test_support::TempDir::new("sweep");
-    let out = tmp.0.clone();
+    // A hostile output path: spaces, non-ASCII letters, a quote and an emoji (issue 19).
+    let out = tmp.0.join("out dir/Ünïcødé it's ✓ 🌈");
     let profile = SweepProfile::parse(PROFILE, "mini.toml").unwrap();
     let s = sweep::sweep(&profile, &out, &data, &Execution::InProcess(Default::default())).unwrap();
     assert!(s.failed.is_empty(), "{:?}", s.failed);
@@ -111,7 +112,16 @@ fn a_miniature_sweep_produces_every_table_and_resumes() {
     assert_eq!(e.emitted, 5);
     let text = std::fs::read_to_string(&jobs).unwrap();
     assert_eq!(text.lines().count(), 5);
-    assert!(text.lines().all(|l| l.starts_with("run-one /")), "{text}");
+    assert!(text.lines().all(|l| l.starts_with("run-one '/")), "{text}");
+    // The shell gives the run directory back whole.
+    let line = text.lines().next().unwrap();
+    let arg = line.strip_prefix("run-one ").unwrap();
+    let echoed = std::process::Command::new("sh")
+        .args(["-c", &format!("printf '%s' {arg}")])
+        .output()
+        .unwrap();
+    let dir = PathBuf::from(String::from_utf8(echoed.stdout).unwrap());
+    assert!(dir.starts_with(&out) && dir.join("config.toml").is_file(), "{}", dir.display());
 }
 
 /// The built-in smoke profile (the shipped Spot mesh, no shared data needed): all 9 models and

@@ -6,7 +6,7 @@
 //! [0, 1] (the `*_linear` helpers convert linear renders with the clamped sRGB OETF,
 //! [`srgb::to_srgb_clamped`]); HDR-FLIP takes linear HDR values. With a mask, PSNR and SSIM
 //! average over masked pixels and HDR-FLIP takes its exposure range and mean over them; without
-//! one they equal the standard definitions (see [`ssim`] and [`flip`] for the parity statements).
+//! one they equal the standard definitions (see [`ssim`](mod@ssim) and [`flip`](mod@flip) for the parity statements).
 //!
 //! Results are raw values; [`aggregate`] averages them per object then over objects and holds
 //! the tables' scaling convention ([`aggregate::TableScale`]).

@@ -97,7 +97,7 @@ pub fn cache_path(dir: &Path, key: u128) -> PathBuf {
 /// content exists, else computed and stored there (the directory is created if needed).
 ///
 /// # Errors
-/// [`Error::View`] for invalid views (as [`crate::precompute()`]) and [`Error::Io`] when the cache
+/// [`crate::Error::View`] for invalid views (as [`crate::precompute()`]) and [`crate::Error::Io`] when the cache
 /// directory or file cannot be created or written. A corrupted file is not an error.
 pub fn precompute_cached(
     mesh: &TriMesh,

@@ -45,7 +45,7 @@ pub struct PairImages {
     pub brdf: Vec<[f32; 3]>,
     /// The noise-free radiance of a generated test pair (`clean/`), else `None`.
     pub clean: Option<Vec<[f32; 3]>>,
-    /// [`flag`] bits per pixel, 0 where there is no sample.
+    /// [`flag`](crate::flag) bits per pixel, 0 where there is no sample.
     pub flags: Vec<u8>,
 }
 

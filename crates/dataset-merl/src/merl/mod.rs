@@ -1,6 +1,6 @@
 //! The MERL isotropic BRDF table (Matusik et al. 2003) in its real binary format (spec section 1).
 //!
-//! * [`format`]: reading, validating and writing the 90 x 90 x 180 channel-planar float64 file.
+//! * [`format`](mod@format): reading, validating and writing the 90 x 90 x 180 channel-planar float64 file.
 //! * [`lookup`]: the reference nearest-lower-bin indexing and trilinear interpolation, by
 //!   Rusinkiewicz angles or by local-frame directions.
 

@@ -4,7 +4,7 @@
 //! * [`images`]: test renders, PSNR / DSSIM / HDR-FLIP / LPIPS on the object mask, FLIP error
 //!   maps and the additive models' diffuse / specular / albedo figures.
 //! * [`analyses`]: energy conservation and the reciprocity RMSE on the test records.
-//! * [`predict`]: the model on CPU records, and as a [`metrics::BatchBrdf`].
+//! * [`predict`](mod@predict): the model on CPU records, and as a [`metrics::BatchBrdf`].
 //! * [`probe`]: the model on the BRDF plots' fixed directions (lit sphere, slices, albedo
 //!   against angle, validity maps), stored as `<run>/probe.bin` when images are written.
 //! * [`fitted`]: a finished run opened for analysis (config, model, scene).

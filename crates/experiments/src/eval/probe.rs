@@ -13,7 +13,7 @@
 //! A spatially varying model is probed at one surface point: the one seen nearest the centre
 //! of the first test view (the validity maps use every pixel's own point). Directional albedo
 //! is `pi / N * sum f(l_k, v)` over stratified cosine-weighted `l_k` with fixed jitter, so a
-//! probe is deterministic. The result of a run is stored as `<run>/probe.bin` ([`write`]).
+//! probe is deterministic. The result of a run is stored as `<run>/probe.bin` ([`write`](fn@write)).
 
 use crate::data::TrainingData;
 use crate::{Error, Result};
@@ -286,7 +286,7 @@ pub fn write(path: &Path, probe: &BrdfProbe) -> Result<()> {
     Ok(())
 }
 
-/// Reads a probe written by [`write`].
+/// Reads a probe written by [`write`](fn@write).
 pub fn read(path: &Path) -> Result<BrdfProbe> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     stdx::cache_file::decode(&bytes, MAGIC, VERSION, 0).map_err(|e| Error::format(path, e))

@@ -214,7 +214,7 @@ pub fn write(
     Ok(())
 }
 
-/// Reads the exact per-vertex parameters back from an asset [`write`] made, with the `gltf`
+/// Reads the exact per-vertex parameters back from an asset [`write`](fn@write) made, with the `gltf`
 /// crate (which validates the document): the uniform row from `extras`, or every column from
 /// the vertex attributes.
 pub fn read(path: &Path) -> Result<ExportedMaterial> {

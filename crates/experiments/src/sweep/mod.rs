@@ -4,7 +4,7 @@
 //! * [`plan`]: scenes and runs of a profile, content-addressed run directories.
 //! * [`execute`]: scene generation, shared LBO tables, runs in-process, as child processes
 //!   (`--jobs`) or as a job file for a cluster (`--emit-jobs`).
-//! * [`collect`]: tables (Markdown + LaTeX) and figures (PNG) from any set of run directories.
+//! * [`collect`](mod@collect): tables (Markdown + LaTeX) and figures (PNG) from any set of run directories.
 //! * [`brdf_figures`]: the BRDF plots of `collect` (lit spheres, slices, albedo, validity).
 //! * [`html_report`]: the HTML report `collect` writes beside them.
 //!

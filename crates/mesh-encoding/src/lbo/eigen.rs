@@ -9,7 +9,7 @@
 //!    `sigma < 0` is a small negative shift (default `-0.01 * 4 pi / area`, a hundredth of the
 //!    Weyl spacing of the eigenvalues) so `A` is positive definite even though `L` is singular
 //!    (one constant null vector per connected component);
-//! 2. runs block Lanczos ([`super::lanczos`]) on `Op = M^(1/2) A^-1 M^(1/2) = (C - sigma)^-1`,
+//! 2. runs block Lanczos (`super::lanczos`) on `Op = M^(1/2) A^-1 M^(1/2) = (C - sigma)^-1`,
 //!    whose largest eigenvalues `theta = 1 / (lambda - sigma)` are the wanted smallest `lambda`.
 //!    Each step solves one block of `b` right-hand sides (default 16) at once, projects out the
 //!    last two blocks (the three-term recurrence), then orthogonalises once against the whole
@@ -33,7 +33,7 @@
 //! basis of `m` vectors, about `2.9 k` with blocks of 16): the solves are a sixth of the time and
 //! the factorisation under 1 %. Keeping the whole basis (no restart) costs `8 n m` bytes. Blocks
 //! of 16 gave the smallest time on the bunny (8: smaller basis but slower narrow GEMMs; 24-64:
-//! larger basis). Spectrum slicing ([`super::slicing`], `slice_size > 0`) is an alternative
+//! larger basis). Spectrum slicing (`super::slicing`, `slice_size > 0`) is an alternative
 //! with a smaller orthogonalisation cost but more factorisations and a global Rayleigh-Ritz;
 //! it was not faster at 513 pairs. Figures and how they were measured: `PERFORMANCE.md`.
 //!
@@ -273,7 +273,9 @@ pub fn smallest_eigenpairs(
     let par = settings.parallelism();
     let factor_start = Instant::now();
     let a = shifted_stiffness(matrices, shift)?;
-    let llt = super::factor::CholeskyFactor::new(a.as_ref(), par)?;
+    // The Lanczos basis the solve reserves beside the factor (n x (max_basis + b) values).
+    let basis_bytes = (n as u64).saturating_mul((max_basis + b) as u64 * 8);
+    let llt = super::factor::CholeskyFactor::new(a.as_ref(), par, basis_bytes)?;
     drop(a);
     let factor_seconds = factor_start.elapsed().as_secs_f64();
     let sqrt_m: Vec<f64> = matrices.mass.iter().map(|m| m.sqrt()).collect();

@@ -15,6 +15,58 @@ use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, factorize_symboli
 use faer::{Conj, MatMut, Par, Side};
 use std::cell::RefCell;
 
+/// The environment variable that sets the memory the LBO's Cholesky factor may take, in GiB
+/// (default: three quarters of the memory available when the solve starts).
+pub const MEMORY_BUDGET_VAR: &str = "NEURAL_BRDF_LBO_MEMORY_GIB";
+
+/// Bytes the factor may take: [`MEMORY_BUDGET_VAR`], else 3/4 of `MemAvailable` (Linux), else
+/// 8 GiB; and where that figure came from.
+fn memory_budget() -> (u64, String) {
+    const GIB: f64 = (1u64 << 30) as f64;
+    if let Some(gib) = std::env::var(MEMORY_BUDGET_VAR).ok().and_then(|v| v.parse::<f64>().ok()) {
+        return ((gib * GIB) as u64, format!("{MEMORY_BUDGET_VAR}={gib}"));
+    }
+    let available = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
+        let line = m.lines().find(|l| l.starts_with("MemAvailable:"))?;
+        line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kib| kib * 1024)
+    });
+    match available {
+        Some(bytes) => {
+            (bytes / 4 * 3, format!("3/4 of the {:.1} GiB available", bytes as f64 / GIB))
+        }
+        None => (8 << 30, "the default".into()),
+    }
+}
+
+/// Refuses a solve whose factor (`nnz` stored values for an `n`-vertex mesh) and `extra` bytes
+/// beside it would not fit the memory budget, before anything is allocated: a clear error with a
+/// decimation hint instead of the kernel's out-of-memory kill. The estimate counts the factor's
+/// values and row indices and the numeric factorisation's peak (about as much again).
+fn check_memory(n: usize, nnz: usize, extra: u64) -> Result<()> {
+    let (budget, source) = memory_budget();
+    memory_verdict(n, nnz, extra, budget, &source)
+}
+
+/// [`check_memory`] against a given budget of `budget` bytes (from `source`).
+fn memory_verdict(n: usize, nnz: usize, extra: u64, budget: u64, source: &str) -> Result<()> {
+    const GIB: f64 = (1u64 << 30) as f64;
+    let need = (nnz as u64).saturating_mul(8 + 8).saturating_mul(2).saturating_add(extra);
+    if need <= budget {
+        return Ok(());
+    }
+    // Fill grows a little faster than linearly with n on surface meshes: aim at what fits.
+    let fits = (n as f64 * (budget as f64 / need as f64).powf(1.1)).max(1.0) as u64;
+    Err(Error::lbo(format!(
+        "the eigenfunctions of this {n}-vertex mesh need about {:.1} GiB (a sparse Cholesky \
+         factor of {nnz} nonzeros and the Lanczos basis), above the budget of {:.1} GiB ({source}); decimate the mesh \
+         to at most about {fits} vertices (the LBO features need no finer mesh; the importer \
+         decimates DiLiGenT-MV's meshes to about 1e5 vertices: `cargo xtask import-diligent \
+         --target-vertices`) or raise {MEMORY_BUDGET_VAR}",
+        need as f64 / GIB,
+        budget as f64 / GIB
+    )))
+}
+
 /// A numeric sparse LL^T factor with a reusable solve workspace.
 pub(crate) struct CholeskyFactor {
     symbolic: SymbolicCholesky<usize>,
@@ -26,8 +78,13 @@ pub(crate) struct CholeskyFactor {
 
 impl CholeskyFactor {
     /// Factors the symmetric positive definite `a` (lower triangle read), fill-reducing
-    /// ordering by AMD (faer's default).
-    pub(crate) fn new(a: SparseColMatRef<'_, usize, f64>, par: Par) -> Result<Self> {
+    /// ordering by AMD (faer's default), after checking that the factor and `extra_bytes` the
+    /// caller allocates beside it (the Lanczos basis) fit the memory budget.
+    pub(crate) fn new(
+        a: SparseColMatRef<'_, usize, f64>,
+        par: Par,
+        extra_bytes: u64,
+    ) -> Result<Self> {
         let symbolic = factorize_symbolic_cholesky(
             a.symbolic(),
             Side::Lower,
@@ -35,6 +92,7 @@ impl CholeskyFactor {
             Default::default(),
         )
         .map_err(|e| Error::lbo(format!("symbolic Cholesky failed: {e:?}")))?;
+        check_memory(a.nrows(), symbolic.len_val(), extra_bytes)?;
         let mut values = vec![0.0; symbolic.len_val()];
         let mut mem = MemBuffer::try_new(
             symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
@@ -70,5 +128,22 @@ impl CholeskyFactor {
             self.par,
             MemStack::new(&mut guard.0),
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_factor_over_the_budget_is_a_clear_error_with_a_decimation_hint() {
+        assert!(memory_verdict(1000, 50_000, 1 << 20, 1 << 30, "test").is_ok());
+        let e = memory_verdict(1_000_000, 400_000_000, 0, 4 << 30, "a 4 GiB test budget")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("1000000-vertex mesh need about 11.9 GiB"), "{e}");
+        assert!(e.contains("budget of 4.0 GiB (a 4 GiB test budget)"), "{e}");
+        assert!(e.contains("decimate the mesh to at most about 30"), "{e}");
+        assert!(e.contains(MEMORY_BUDGET_VAR), "{e}");
     }
 }

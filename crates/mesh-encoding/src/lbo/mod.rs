@@ -35,3 +35,4 @@ pub use eigen::{
     smallest_eigenpairs,
 };
 pub use encoding::{LboEncoding, LboEncodingConfig, block_selection};
+pub use factor::MEMORY_BUDGET_VAR;
