@@ -159,6 +159,20 @@ fn models_fit_the_scene_and_eval_scores_them() {
         assert_eq!(count("albedo"), if additive { 2 } else { 0 }, "{kind}: albedo maps");
         let first = std::fs::read_dir(run.join("flip")).unwrap().next().unwrap().unwrap();
         assert_eq!(image::open(first.path()).unwrap().width(), 64, "{kind}: FLIP map size");
+        // The model fitted to the scene stays finite, forward and backward, on 2^14 adversarial
+        // direction pairs and feature rows (issue 19: gradients of trained models).
+        let c = config(kind, 300, eval).model;
+        let device = brdf_neural::device::cpu_training();
+        let weights = RunDir::new(&run).weights();
+        let model = burn::module::Module::load_file(c.init(&device).unwrap(), &weights);
+        let n = 1 << 14;
+        let (l, v) = test_support::adversarial::direction_pairs(9, 0, n);
+        let spatial = test_support::adversarial::spatial_rows(9, 0, n, c.spatial_dim);
+        let samples = brdf_neural::Samples { spatial: &spatial, l: &l, v: &v };
+        let checked =
+            brdf_neural::finite_check::check_forward_backward(&model, &c, &samples, &device);
+        let checked = checked.unwrap();
+        assert!(checked.problem.is_none() && checked.gradients > 0, "{kind}: {checked:?}");
         if kind == "disney" {
             // The fitted material as a MERL file: the real format, readable back, finite,
             // and (a Lambertian scene, 300 steps) within a factor 2 of albedo / pi at normal
