@@ -296,6 +296,29 @@ mod tests {
         )
     }
 
+    /// Every shipped data manifest, corrupted (test_support::corrupt): an error or a value,
+    /// never a panic (issue 19).
+    #[test]
+    fn corrupted_manifests_give_errors_not_panics() {
+        let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data-manifests");
+        let seeds: Vec<Vec<u8>> = std::fs::read_dir(&shipped)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+            .map(|p| std::fs::read(p).unwrap())
+            .collect();
+        assert!(seeds.len() >= 5, "the shipped manifests");
+        let d = tmp("fuzz");
+        std::fs::create_dir_all(&d).unwrap();
+        let path = d.join("corrupted.toml");
+        let ran = test_support::corrupt::fuzz_loader("data-manifest", &seeds, 3000, |b| {
+            std::fs::write(&path, b).unwrap();
+            let _ = load(&path);
+        });
+        assert!(ran >= 3000);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
     #[test]
     fn unknown_key_names_file_and_key() {
         let dir = tmp("unknown-key");
