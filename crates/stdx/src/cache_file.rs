@@ -17,12 +17,23 @@ const HEADER: usize = 8 + 4 + 16;
 /// The complete file of `value` under this magic, version and key.
 pub fn encode<T: Serialize>(magic: &[u8; 8], version: u32, key: u128, value: &T) -> Vec<u8> {
     let payload = postcard::to_stdvec(value).expect("in-memory postcard encoding cannot fail");
+    seal(magic, version, key, &payload)
+}
+
+/// The payload bytes of a file (between the header and the checksum), if it is long enough.
+pub fn payload(bytes: &[u8]) -> Option<&[u8]> {
+    bytes.get(HEADER..bytes.len().checked_sub(8)?)
+}
+
+/// A file around raw payload bytes, with a valid checksum: what the robustness tests use to get
+/// a corrupted payload past the checksum and into the decoder.
+pub fn seal(magic: &[u8; 8], version: u32, key: u128, payload: &[u8]) -> Vec<u8> {
     let mut out = Vec::with_capacity(HEADER + payload.len() + 8);
     out.extend_from_slice(magic);
     out.extend_from_slice(&version.to_le_bytes());
     out.extend_from_slice(&key.to_le_bytes());
-    out.extend_from_slice(&payload);
-    out.extend_from_slice(&xxh3_64(&payload).to_le_bytes());
+    out.extend_from_slice(payload);
+    out.extend_from_slice(&xxh3_64(payload).to_le_bytes());
     out
 }
 

@@ -177,6 +177,19 @@ mod tests {
         assert!(decode(&version, 42, 4, 3).unwrap_err().contains("version"));
     }
 
+    /// Corrupted payloads sealed with a valid checksum (what a bug in a writer, not a damaged
+    /// disk, would produce) reach the decoder: an error or a value, never a panic, and no
+    /// allocation beyond the cap (a length of 2^40 elements is an error).
+    #[test]
+    fn corrupted_payloads_past_the_checksum_give_errors_not_panics() {
+        let bytes = encode(&pairs(), 42);
+        let seed = stdx::cache_file::payload(&bytes).unwrap().to_vec();
+        let ran = test_support::corrupt::fuzz_loader("lbo-cache", &[seed], 3000, |b| {
+            let _ = decode(&stdx::cache_file::seal(MAGIC, FORMAT_VERSION, 42, b), 42, 4, 3);
+        });
+        assert!(ran >= 3000);
+    }
+
     #[test]
     fn key_depends_on_mesh_k_and_settings() {
         let v = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
