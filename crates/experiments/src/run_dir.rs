@@ -64,6 +64,16 @@ impl RunDir {
         self.0.join("weights.bpk")
     }
 
+    /// `model.safetensors`: the final weights for other tools (`export::portable`).
+    pub fn portable_weights(&self) -> PathBuf {
+        self.0.join("model.safetensors")
+    }
+
+    /// `model.json`: the description beside [`RunDir::portable_weights`].
+    pub fn portable_description(&self) -> PathBuf {
+        self.0.join("model.json")
+    }
+
     /// The snapshot of the weights after `step` steps.
     pub fn snapshot(&self, step: u64) -> PathBuf {
         self.0.join("snapshots").join(format!("step-{step:09}.bpk"))

@@ -237,6 +237,9 @@ pub fn fit_and_keep(
         format!("step budget reached ({} steps)", state.step)
     });
     save_weights(&model, &dir.weights())?;
+    // The same weights for other tools (safetensors + JSON), before metrics.json marks the run
+    // finished, so a kill in between redoes both.
+    crate::export::portable::write(&dir, &dir.weights(), config, &scene, &cache)?;
     let mut metrics = run_metrics(config, &state, &data, val.len());
     metrics.backend = Some(options.backend);
     metrics.val_loss_floor = val_floor;

@@ -23,6 +23,12 @@
 //! # Ok::<(), mesh_encoding::Error>(())
 //! ```
 
+/// In the unit tests, a single allocation beyond 4 GiB aborts: the cache decoders' corrupted
+/// payloads (a length of 2^40 elements) must be errors, not out-of-memory kills.
+#[cfg(test)]
+#[global_allocator]
+static ALLOC: test_support::corrupt::CappedAlloc = test_support::corrupt::CappedAlloc(1 << 32);
+
 pub mod error;
 pub mod lbo;
 pub mod mesh;

@@ -28,7 +28,8 @@ use crate::visibility::Visibility;
 /// 2: the payload is the serde encoding of [`ScenePrecompute`] (postcard).
 pub const FORMAT_VERSION: u32 = 2;
 
-const MAGIC: &[u8; 8] = b"NBRDFRCP";
+/// The first 8 bytes of every ray-casting cache file.
+pub const MAGIC: &[u8; 8] = b"NBRDFRCP";
 
 /// How [`precompute_cached`] obtained its result.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -126,8 +127,10 @@ pub(crate) fn encode(scene: &ScenePrecompute, key: u128) -> Vec<u8> {
     stdx::cache_file::encode(MAGIC, FORMAT_VERSION, key, scene)
 }
 
-/// Checks and decodes a file; the error says which check failed.
-pub(crate) fn decode(bytes: &[u8], key: u128) -> std::result::Result<ScenePrecompute, String> {
+/// Checks and decodes the bytes of a cache file for `key` (what [`precompute_cached`] does
+/// before it trusts a file); the error says which check failed. Public for tools that inspect
+/// caches and for the fuzz targets.
+pub fn decode(bytes: &[u8], key: u128) -> std::result::Result<ScenePrecompute, String> {
     let scene: ScenePrecompute = stdx::cache_file::decode(bytes, MAGIC, FORMAT_VERSION, key)?;
     for v in &scene.views {
         let n = v.pixels.len();
@@ -143,4 +146,32 @@ pub(crate) fn decode(bytes: &[u8], key: u128) -> std::result::Result<ScenePrecom
         }
     }
     Ok(scene)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Camera, precompute};
+    use mesh_encoding::glam::Vec3;
+
+    /// Corrupted payloads sealed with a valid checksum (what a bug in a writer, not a damaged
+    /// disk, would produce) reach the decoder: an error or a value, never a panic, and no
+    /// allocation beyond the cap (a length of 2^40 elements is an error) (issue 19).
+    #[test]
+    fn corrupted_payloads_past_the_checksum_give_errors_not_panics() {
+        let positions = vec![Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::Y];
+        let mesh = TriMesh::new(positions, vec![[0, 1, 2]]).unwrap();
+        let camera = Camera::look_at(3.0 * Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0, 6, 5).unwrap();
+        let lights = vec![Vec3::Z, Vec3::new(0.6, 0.0, 0.8)];
+        let views = vec![View { camera, lights, mask: None }];
+        let scene = precompute(&mesh, &views, &PrecomputeSettings::default()).unwrap();
+        assert!(scene.views[0].pixels.len() > 3, "the seed covers some pixels");
+        let bytes = encode(&scene, 42);
+        assert_eq!(decode(&bytes, 42).unwrap(), scene);
+        let seed = stdx::cache_file::payload(&bytes).unwrap().to_vec();
+        let ran = test_support::corrupt::fuzz_loader("raycast-cache", &[seed], 3000, |b| {
+            let _ = decode(&stdx::cache_file::seal(MAGIC, FORMAT_VERSION, 42, b), 42);
+        });
+        assert!(ran >= 3000);
+    }
 }

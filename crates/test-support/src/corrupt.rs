@@ -10,6 +10,10 @@
 //! [`CappedAlloc`] turns an allocation beyond a stated cap (a header that claims 2^40 elements)
 //! into an immediate abort with a message, instead of an out-of-memory kill minutes later: a
 //! test binary installs it as its `#[global_allocator]`.
+//!
+//! With [`SEED_DIR_VAR`] set to a folder, [`fuzz_loader`] also copies its seeds there, one
+//! sub-folder per target (`-` written `_`): `NEURAL_BRDF_FUZZ_SEEDS=$PWD/fuzz/corpus cargo test
+//! --workspace corrupted` fills the libFuzzer targets' corpora with the same real files.
 
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestCaseError, TestError, TestRunner};
@@ -88,6 +92,19 @@ pub fn apply(bytes: &mut Vec<u8>, m: &Mutation) {
     }
 }
 
+/// The environment variable naming a folder that [`fuzz_loader`] copies its seeds to.
+pub const SEED_DIR_VAR: &str = "NEURAL_BRDF_FUZZ_SEEDS";
+
+/// Copies the seeds to `$NEURAL_BRDF_FUZZ_SEEDS/<target>/seed-<i>` when the variable is set.
+fn export_seeds(target: &str, seeds: &[Vec<u8>]) {
+    let Some(root) = std::env::var_os(SEED_DIR_VAR) else { return };
+    let dir = std::path::Path::new(&root).join(target.replace('-', "_"));
+    let _ = std::fs::create_dir_all(&dir);
+    for (i, seed) in seeds.iter().enumerate() {
+        let _ = std::fs::write(dir.join(format!("seed-{i}")), seed);
+    }
+}
+
 /// Runs `loader` on `cases` corrupted copies of the seeds (1 to 4 mutations each, every seed
 /// in turn, deterministic for the workspace's `PROPTEST_RNG_SEED`) and on each seed as it is.
 /// The loader returns whatever it likes; only a panic fails, and the input that caused it is
@@ -97,6 +114,7 @@ pub fn apply(bytes: &mut Vec<u8>, m: &Mutation) {
 /// When the loader panics on some input (after shrinking), naming the saved file.
 pub fn fuzz_loader(target: &str, seeds: &[Vec<u8>], cases: u32, loader: impl Fn(&[u8])) -> usize {
     assert!(!seeds.is_empty(), "{target}: no seed file");
+    export_seeds(target, seeds);
     for s in seeds {
         if catch_unwind(AssertUnwindSafe(|| loader(s))).is_err() {
             panic!("{target}: the loader panicked on an unmodified seed");

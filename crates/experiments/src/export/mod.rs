@@ -3,7 +3,8 @@
 //! as a glTF 2.0 asset ([`gltf`]), a Mitsuba 3 scene ([`mitsuba`]) and a pbrt-v4 scene
 //! ([`pbrt`]), the last two with the scene's cameras and lights. [`round_trip`] re-renders the
 //! test views from an exported file with `brdf-analytic` and scores it against the fit's own
-//! renders.
+//! renders. [`portable`] writes any fitted model's weights as safetensors with a JSON
+//! description, for PyTorch and numpy users.
 //!
 //! Purely neural fits leave as MERL tables only. The RGL tabulated format (Dupuy and Jakob
 //! 2018) that Mitsuba 3's and pbrt-v4's `measured` BSDFs read is not written: its readers take
@@ -19,6 +20,7 @@ pub mod merl;
 pub mod mitsuba;
 pub mod pbrt;
 pub mod ply;
+pub mod portable;
 pub mod round_trip;
 
 pub use bundle::{ExportSummary, Format, export};

@@ -19,11 +19,12 @@ use super::assembly::LboMatrices;
 use super::eigen::{EigenSettings, Eigenpairs, smallest_eigenpairs};
 use crate::error::{Error, Result};
 
-const MAGIC: &[u8; 8] = b"NBLBOEIG";
+/// The first 8 bytes of every eigenpair cache file.
+pub const MAGIC: &[u8; 8] = b"NBLBOEIG";
 /// Bumped whenever the file layout or the meaning of the cached numbers changes.
 /// Version 2: the faster block Lanczos (block 16, adaptive Ritz checks; rounding-level changes).
 /// Version 3: the payload is [`CachedPairs`] in the workspace's cache container (postcard).
-const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 3;
 
 /// The payload of a cache file.
 #[derive(serde::Serialize, serde::Deserialize)]
@@ -132,8 +133,15 @@ fn encode(pairs: &Eigenpairs, key: u128) -> Vec<u8> {
     stdx::cache_file::encode(MAGIC, FORMAT_VERSION, key, &payload)
 }
 
-/// Parses and checks a cache file; the error says why it is unusable.
-fn decode(bytes: &[u8], key: u128, n: usize, k: usize) -> std::result::Result<Eigenpairs, String> {
+/// Parses and checks the bytes of a cache file for `key`, `n` vertices and `k` pairs (what
+/// [`cached_eigenpairs`] does before it trusts a file); the error says why it is unusable.
+/// Public for tools that inspect caches and for the fuzz targets.
+pub fn decode(
+    bytes: &[u8],
+    key: u128,
+    n: usize,
+    k: usize,
+) -> std::result::Result<Eigenpairs, String> {
     let p: CachedPairs = stdx::cache_file::decode(bytes, MAGIC, FORMAT_VERSION, key)?;
     if (p.n, p.k) != (n as u64, k as u64) {
         return Err(format!("sizes {} x {}, expected {n} x {k}", p.n, p.k));
