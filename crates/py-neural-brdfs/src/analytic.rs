@@ -236,14 +236,12 @@ fn build(kind: &'static str, kw: &mut Kwargs<'_>) -> PyResult<Built> {
 
 /// Checks that every row is a finite unit vector (to 1e-3): the models assume unit directions,
 /// and a silently unnormalised input would give silently wrong values.
-fn unit_rows<'a>(a: &'a PyReadonlyArray2<'_, f64>, name: &str) -> PyResult<Vec<[f64; 3]>> {
+fn unit_rows(a: &PyReadonlyArray2<'_, f64>, name: &str) -> PyResult<Vec<[f64; 3]>> {
     let flat = rows::<f64, 3>(a, name)?;
     let out = crate::arrays::as_vec3(flat);
-    if let Some((i, r)) = out
-        .iter()
-        .enumerate()
-        .find(|(_, r)| !((r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt() - 1.0).abs().lt(&1e-3))
-    {
+    // NaN fails the comparison, so a non-finite row is not a unit vector either.
+    let unit = |r: &[f64; 3]| ((r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt() - 1.0).abs() < 1e-3;
+    if let Some((i, r)) = out.iter().enumerate().find(|(_, r)| !unit(r)) {
         return Err(PyValueError::new_err(format!(
             "{name}: row {i} is {r:?}, not a finite unit vector (normalise directions first)"
         )));

@@ -163,7 +163,7 @@ fn safetensors_bytes(tensors: &BTreeMap<String, Entry>) -> Vec<u8> {
         offset += e.bytes.len();
     }
     let mut text = serde_json::Value::Object(header).to_string().into_bytes();
-    while (8 + text.len()) % 8 != 0 {
+    while !text.len().is_multiple_of(8) {
         text.push(b' ');
     }
     let mut out = Vec::with_capacity(8 + text.len() + offset);
@@ -186,7 +186,7 @@ mod tests {
         t.insert("a".into(), Entry { dtype: "I32", shape: vec![1, 1], bytes: vec![7, 0, 0, 0] });
         let bytes = safetensors_bytes(&t);
         let n = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
-        assert_eq!((8 + n) % 8, 0);
+        assert!(n.is_multiple_of(8), "the data starts 8-byte aligned");
         let header: serde_json::Value = serde_json::from_slice(&bytes[8..8 + n]).unwrap();
         assert_eq!(header["a"]["data_offsets"], serde_json::json!([0, 4]));
         assert_eq!(header["b"]["data_offsets"], serde_json::json!([4, 12]));

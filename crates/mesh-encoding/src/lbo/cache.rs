@@ -23,7 +23,8 @@ use crate::error::{Error, Result};
 pub const MAGIC: &[u8; 8] = b"NBLBOEIG";
 /// Bumped whenever the file layout or the meaning of the cached numbers changes.
 /// Version 2: the faster block Lanczos (block 16, adaptive Ritz checks; rounding-level changes).
-/// Version 3: the payload is [`CachedPairs`] in the workspace's cache container (postcard).
+/// Version 3: the payload is `CachedPairs` (n, k, values, vectors) in the workspace's cache
+/// container (postcard).
 pub const FORMAT_VERSION: u32 = 3;
 
 /// The payload of a cache file.
