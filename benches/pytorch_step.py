@@ -8,11 +8,15 @@ output (RGB); loss = MSE(f * w, target) with a per-sample weight w (E * shadow *
 backward; Adam (lr 1e-4). Batch 32768 by default. Inputs are random (the angle features'
 computation is not part of the timed step in either implementation).
 
-Usage: python3 benches/pytorch_step.py [--batch 32768] [--threads 2] [--reps 20] [--bf16] [--machine]
+Usage: python3 benches/pytorch_step.py [--batch 32768] [--threads 2] [--reps 20] [--bf16]
+       [--device cpu|cuda] [--tf32] [--machine]
 Prints the median and mean step time in ms and samples/s. `--bf16` runs forward and loss under
 `torch.autocast("cpu", dtype=torch.bfloat16)` (bf16 matrix products through oneDNN, which uses
 AVX512-BF16 where the CPU has it; f32 master weights and Adam): what a mixed-precision path
-buys on this CPU.
+buys on this CPU. `--device cuda` runs the step on the GPU (each step ends with
+`torch.cuda.synchronize()`, so the host clock times the device's work); there f32 matrix products
+are IEEE f32 unless `--tf32` lets cuBLAS round their operands to TF32 on the tensor cores, and
+`--bf16` autocasts on CUDA instead.
 """
 
 import contextlib
@@ -55,20 +59,30 @@ def main():
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--reps", type=int, default=20)
     p.add_argument("--bf16", action="store_true", help="bf16 autocast (mixed precision)")
+    p.add_argument("--device", default="cpu", help="cpu or cuda")
+    p.add_argument("--tf32", action="store_true", help="CUDA: allow TF32 matrix products")
     p.add_argument("--machine", action="store_true", help="print only 'median_ms <value>'")
     a = p.parse_args()
     torch.set_num_threads(a.threads)
+    dev = torch.device(a.device)
+    cuda = dev.type == "cuda"
+    torch.backends.cuda.matmul.allow_tf32 = a.tf32
+    torch.backends.cudnn.allow_tf32 = a.tf32
     torch.manual_seed(1)
-    model = SingleMlp()
+    model = SingleMlp().to(dev)
     opt = torch.optim.Adam(model.parameters(), lr=1e-4, eps=1e-5)
-    x = torch.rand(a.batch, 188) * 2 - 1
-    w = torch.rand(a.batch, 1) * 3
-    target = torch.rand(a.batch, 3)
+    x = (torch.rand(a.batch, 188) * 2 - 1).to(dev)
+    w = (torch.rand(a.batch, 1) * 3).to(dev)
+    target = torch.rand(a.batch, 3).to(dev)
 
     def precision():
         if a.bf16:
-            return torch.autocast("cpu", dtype=torch.bfloat16)
+            return torch.autocast(dev.type, dtype=torch.bfloat16)
         return contextlib.nullcontext()
+
+    def sync():
+        if cuda:
+            torch.cuda.synchronize()
 
     def step():
         opt.zero_grad(set_to_none=True)
@@ -76,8 +90,9 @@ def main():
             loss = ((model(x).float() * w - target) ** 2).mean()
         loss.backward()
         opt.step()
+        sync()
 
-    for _ in range(3):
+    for _ in range(10 if cuda else 3):
         step()
     times = []
     for _ in range(a.reps):
@@ -89,8 +104,10 @@ def main():
     if a.machine:
         print(f"median_ms {med * 1e3:.3f}")
         return
+    mode = "bf16 autocast" if a.bf16 else ("tf32" if a.tf32 and cuda else "f32")
+    where = torch.cuda.get_device_name(dev) if cuda else "cpu"
     print(
-        f"pytorch {torch.__version__} {'bf16 autocast' if a.bf16 else 'f32'} "
+        f"pytorch {torch.__version__} {where} {mode} "
         f"threads {torch.get_num_threads()} batch {a.batch} "
         f"params {n_params}: median {med * 1e3:.1f} ms, mean {statistics.mean(times) * 1e3:.1f} ms, "
         f"{a.batch / med:.0f} samples/s"

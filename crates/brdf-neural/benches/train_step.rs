@@ -11,8 +11,9 @@
 //! - `BRDF_BENCH_ALL_MODELS=1` adds the six other model kinds to the summary (their default
 //!   configurations; `docs/reproduce.md` sizes the `full` profile from these step times);
 //! - `BRDF_BENCH_PYTORCH=python3` (a Python with torch) also runs `benches/pytorch_step.py`,
-//!   the same Single MLP step in PyTorch on the same number of threads, back to back with
-//!   ours: three rounds of 10 steps each side after warm-up, and prints the ratios;
+//!   the same Single MLP step in PyTorch on the same number of threads (on CUDA for the GPU
+//!   backends), back to back with ours: three rounds of 10 steps each side after warm-up, and
+//!   prints the ratios;
 //! - `BRDF_KEEP_MALLOC=0` turns the host-memory policy off (`brdf_neural::host_memory`);
 //! - `BRDF_BENCH_PRECISION=f32,bf16` (default `f32`) also times every step with bf16 matrix
 //!   products ([`brdf_neural::precision`], flex only), with the PyTorch comparison under bf16
@@ -268,13 +269,29 @@ fn median_step(step: &mut Step, reps: usize) -> f64 {
     times[reps / 2]
 }
 
-/// Median step time (seconds) of `benches/pytorch_step.py` run by `python`, or why not.
-fn pytorch_step(python: &str, n: usize, reps: usize, bf16: bool) -> Result<f64, String> {
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../../benches/pytorch_step.py");
+/// Median step time (seconds) of `benches/pytorch_step.py` run by `python`, or why not. A GPU
+/// backend is compared with PyTorch on CUDA (f32, no TF32), a CPU backend with PyTorch on the
+/// CPU on as many threads.
+fn pytorch_step(
+    python: &str,
+    backend: Backend,
+    n: usize,
+    reps: usize,
+    bf16: bool,
+) -> Result<f64, String> {
+    // The script beside the sources this bench was built from, else (a bench binary carried to
+    // another machine and run from a checkout's root) the checkout's own.
+    let built = concat!(env!("CARGO_MANIFEST_DIR"), "/../../benches/pytorch_step.py");
+    let script =
+        if std::path::Path::new(built).exists() { built } else { "benches/pytorch_step.py" };
     let threads = rayon_threads().to_string();
+    let device = match backend {
+        Backend::Wgpu | Backend::Cuda => "cuda",
+        Backend::Flex | Backend::NdArray => "cpu",
+    };
     let out = std::process::Command::new(python)
         .args([script, "--batch", &n.to_string(), "--threads", &threads])
-        .args(["--reps", &reps.to_string(), "--machine"])
+        .args(["--reps", &reps.to_string(), "--machine", "--device", device])
         .args(if bf16 { &["--bf16"][..] } else { &[] })
         .output()
         .map_err(|e| format!("{python}: {e}"))?;
@@ -314,7 +331,7 @@ fn bench(cr: &mut Criterion) {
                 for _ in 0..3 {
                     median_step(&mut step, 3);
                     let ours = median_step(&mut step, 10);
-                    match pytorch_step(&python, n, 10, bf16) {
+                    match pytorch_step(&python, backend, n, 10, bf16) {
                         Ok(theirs) => versus_pytorch.push((backend, precision, ours, theirs)),
                         Err(e) => {
                             eprintln!("PyTorch baseline not run: {e}");

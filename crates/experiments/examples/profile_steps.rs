@@ -6,7 +6,16 @@
 //! ```sh
 //! cargo xtask reproduce-tables            # once, for the scenes, caches and run configs
 //! cargo run --release -p experiments --example profile_steps -- out/reproduce spot__blue-acrylic 300
+//! cargo run --release -p experiments --features wgpu --example profile_steps -- out/reproduce spot__blue-acrylic 300 wgpu
 //! ```
+//!
+//! `profile_steps --prepare <profile> <out>` makes a profile's scenes, caches and run
+//! configurations without training (what `cargo xtask reproduce-tables --emit-jobs` does), for
+//! a machine that has this example but no xtask (the GPU measurement, benches/device_gpu.sh).
+//!
+//! The optional fourth argument is the backend that trains (`cpu`, `wgpu`, `cuda`; default `cpu`);
+//! evaluation runs where `experiments eval` runs it. The optional fifth is a comma-separated list
+//! of model kinds to profile (as printed, for example `SingleMlp,Disney`; default: all).
 //!
 //! Run it on a quiet machine (no compile: `pgrep -a rustc`). The runs are the sweep's own
 //! configurations with `iterations` set to the step count and snapshots off.
@@ -20,10 +29,33 @@ use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if let [flag, profile, out] = args.as_slice()
+        && flag == "--prepare"
+    {
+        let profile = experiments::sweep::SweepProfile::load(profile)?;
+        let how = experiments::sweep::Execution::Emit {
+            file: PathBuf::from(out).join("jobs.txt"),
+            command: vec!["profile_steps".into()],
+        };
+        let data = std::env::var_os("NEURAL_BRDF_DATA")
+            .map_or_else(|| PathBuf::from("data"), PathBuf::from);
+        let s = experiments::sweep::sweep(&profile, out.as_ref(), &data, &how)?;
+        println!(
+            "{}: {} scenes generated, {} runs planned",
+            profile.name,
+            s.scenes_generated,
+            s.runs.len()
+        );
+        return Ok(());
+    }
     let [out, scene, rest @ ..] = args.as_slice() else {
-        return Err("usage: profile_steps <sweep out dir> <scene name> [steps]".into());
+        return Err(
+            "usage: profile_steps <sweep out dir> <scene name> [steps] [backend] [models]".into()
+        );
     };
     let steps: u64 = rest.first().map_or(Ok(300), |s| s.parse())?;
+    let backend = brdf_neural::device::Backend::parse(rest.get(1).map_or("cpu", String::as_str))?;
+    let only: Option<Vec<&str>> = rest.get(2).map(|m| m.split(',').map(str::trim).collect());
     let layout = SweepLayout::new(out);
     let mut runs: Vec<PathBuf> = std::fs::read_dir(layout.runs())?
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -37,7 +69,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         return Err(format!("no default runs of {scene} under {}", layout.runs().display()).into());
     }
     let tmp = std::env::temp_dir().join(format!("profile-steps-{}", std::process::id()));
-    println!("{steps} steps per model on {scene}; ms per step, then evaluation seconds\n");
+    println!(
+        "{steps} steps per model on {scene}, backend {backend}; ms per step, then evaluation \
+         seconds\n"
+    );
     println!(
         "| model | gather | encode | forward | loss | backward | optimizer | validation | \
          bookkeeping | total | samples/s |"
@@ -49,9 +84,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         config.train.iterations = steps;
         config.train.snapshots = false;
         let kind = format!("{:?}", config.model.kind);
+        if only.as_ref().is_some_and(|o| !o.contains(&kind.as_str())) {
+            continue;
+        }
         let run = tmp.join(&kind);
-        let options =
-            FitOptions { progress: false, cache_dir: Some(layout.cache()), ..Default::default() };
+        let options = FitOptions {
+            progress: false,
+            cache_dir: Some(layout.cache()),
+            backend,
+            ..Default::default()
+        };
         let (outcome, trained) = fit_and_keep(&config, &run, options)?;
         let trained = trained.ok_or_else(|| format!("{kind}: did not train ({outcome:?})"))?;
         let metrics = experiments::run_dir::RunMetrics::read(&RunDir::new(&run).metrics())?;
@@ -67,6 +109,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let start = Instant::now();
         let fitted = FittedRun::from_trained(config, trained, layout.cache());
         let test = eval_fitted(&fitted, &run, false, start)?;
+        eprintln!("{kind}: evaluated in {:.2} s", test.seconds);
         evals.push((kind, test));
     }
     println!(

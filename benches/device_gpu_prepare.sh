@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Builds what `benches/device_gpu.sh` runs on a lent GPU machine and puts it in `.devrun/` (and
+# the Vulkan loader's packages in `.gl/`), both ignored through .git/info/exclude. Run from the
+# checkout's root on the development machine; then carry `.devrun` and `.gl` with the call.
+set -euo pipefail
+R=.devrun
+grep -qx '/.devrun/' .git/info/exclude || echo /.devrun/ >>.git/info/exclude
+grep -qx '/.gl/' .git/info/exclude || echo /.gl/ >>.git/info/exclude
+if [ ! -d .gl ]; then
+    mkdir -p .gl /tmp/amd64/partial
+    o='-oAPT::Architecture=amd64 -oAPT::Architectures=amd64 -oDir::State::Lists=/tmp/amd64'
+    # shellcheck disable=SC2086
+    apt-get $o update >/dev/null
+    # shellcheck disable=SC2086
+    (cd .gl && apt-get $o download libvulkan1 libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2)
+fi
+
+# The bench and the test build with one feature set (their dev-dependencies join it); the
+# example also makes the scenes there (`--prepare`), so no xtask travels.
+cargo build --release -p experiments --features wgpu --example profile_steps
+cargo bench -p experiments -p brdf-neural --features experiments/wgpu --bench train_step --no-run
+cargo test --release -p experiments -p brdf-neural --features experiments/wgpu --test gpu_backend --no-run
+
+newest() { find target/release/deps -maxdepth 1 -type f -executable -name "$1-*" -printf '%T@ %p\n' | sort -n | tail -1 | cut -d' ' -f2; }
+rm -rf $R && mkdir -p $R/bin
+cp target/release/examples/profile_steps $R/bin/
+cp "$(newest train_step)" $R/bin/train_step
+cp "$(newest gpu_backend)" $R/bin/gpu_backend
+strip $R/bin/*
+tar -cJf $R/bin.tar.xz -C $R bin
+rm -rf $R/bin
+du -sh $R .gl
