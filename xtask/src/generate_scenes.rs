@@ -20,6 +20,8 @@ pub struct Options {
     pub views: usize,
     /// Lights per view.
     pub lights: usize,
+    /// Point lights at this distance from the origin (mesh radii) instead of directional ones.
+    pub point_light_distance: Option<f32>,
     /// Directory with real MERL binaries, which take precedence.
     pub merl_dir: Option<PathBuf>,
     /// Output directory; scenes go to `<out>/<mesh>__<material>`.
@@ -37,7 +39,10 @@ pub fn run(opts: Options) -> Result<()> {
     anyhow::ensure!(!materials.is_empty(), "give at least one --material");
     anyhow::ensure!(opts.views >= 2, "--views must be at least 2 (half train, half test)");
     anyhow::ensure!(opts.lights >= 2, "--lights must be at least 2");
-    let settings = SceneSettings::with_counts(opts.size, opts.views, opts.lights);
+    let settings = SceneSettings {
+        point_light_distance: opts.point_light_distance,
+        ..SceneSettings::with_counts(opts.size, opts.views, opts.lights)
+    };
     let total = opts.meshes.len() * materials.len();
     let mut done = 0;
     for mesh in &opts.meshes {

@@ -3,9 +3,11 @@
 //! Every user-facing job of the workspace is a subcommand here; run `cargo xtask --help`.
 //! The main job is `reproduce-tables` (the paper's tables and figures from one command, see
 //! `docs/reproduce.md`); `collect` rebuilds them from any run directories, `fetch-data`
-//! downloads the real datasets, `import-diligent` turns a DiLiGenT capture into a scene.
+//! downloads the real datasets, `import-diligent` turns a DiLiGenT capture into a scene,
+//! `import-capture` a user's own (docs/capture-format.md).
 
 mod analytic_report;
+mod capture;
 mod fetch;
 mod generate_scenes;
 mod import_diligent;
@@ -65,6 +67,10 @@ enum Command {
         /// Lights per view (30 of 42 train by default, the same fraction otherwise).
         #[arg(long, default_value_t = 42)]
         lights: usize,
+        /// Point lights at this distance from the origin, in mesh radii (> 1; their irradiance
+        /// at the origin is the directional lights'), instead of directional lights.
+        #[arg(long)]
+        point_lights: Option<f32>,
         /// Directory with real MERL binaries (`<name>.binary`), which take precedence.
         #[arg(long)]
         merl_dir: Option<PathBuf>,
@@ -168,6 +174,28 @@ enum Command {
         #[arg(long, default_value_t = 100_000)]
         target_vertices: usize,
     },
+    /// Import your own capture (posed images, mesh, calibrated directional or point lights;
+    /// docs/capture-format.md) as a scene directory: checks the mesh against every view's mask
+    /// (IoU) and refuses a misaligned capture, writing nothing.
+    ImportCapture {
+        /// The capture folder (holding `capture.toml`).
+        capture: PathBuf,
+        /// Output scene directory.
+        #[arg(long)]
+        out: PathBuf,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Write a scene directory in the capture format (transforms.json, lights.json, EXR images,
+    /// PNG masks, PLY mesh): an example to start from, and the importer's round trip.
+    ExportCapture {
+        /// The scene directory.
+        scene: PathBuf,
+        /// Output capture folder.
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Print the workspace's crates in layering order (bottom first).
     Layers,
 }
@@ -196,7 +224,17 @@ fn main() -> Result<()> {
             stdx::fs::write_atomic(&out, md.as_bytes())?;
             eprintln!("report written to {}", out.display());
         }
-        Command::GenerateScenes { meshes, materials, seed, size, views, lights, merl_dir, out } => {
+        Command::GenerateScenes {
+            meshes,
+            materials,
+            seed,
+            size,
+            views,
+            lights,
+            point_lights,
+            merl_dir,
+            out,
+        } => {
             generate_scenes::run(generate_scenes::Options {
                 meshes,
                 materials,
@@ -204,6 +242,7 @@ fn main() -> Result<()> {
                 size,
                 views,
                 lights,
+                point_light_distance: point_lights,
                 merl_dir,
                 out,
             })?;
@@ -235,6 +274,8 @@ fn main() -> Result<()> {
         Command::ImportDiligent { src, out, train_lights, test_lights, target_vertices } => {
             import_diligent::run(&src, &out, train_lights, test_lights, target_vertices)?;
         }
+        Command::ImportCapture { capture, out, quiet } => capture::import(&capture, &out, !quiet)?,
+        Command::ExportCapture { scene, out } => capture::export(&scene, &out)?,
         Command::Layers => {
             for c in layers::layers() {
                 println!("{c}");

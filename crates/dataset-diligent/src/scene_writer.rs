@@ -98,11 +98,12 @@ fn views(s: &CapturedScene<'_>) -> Result<(Vec<View>, Vec<ViewInfo>)> {
                 intensity: [1.0; 3],
                 split: v.split,
                 source_index: Some(i as u32 + 1),
+                position: None,
             })
             .collect();
         views.push(View {
             camera,
-            lights: lights.iter().map(|l| Vec3::from_array(l.direction)).collect(),
+            lights: lights.iter().map(LightInfo::source).collect(),
             mask: None,
         });
         infos.push(ViewInfo { split: v.split, k: v.k, r: v.r, t: v.t, lights });
@@ -211,7 +212,7 @@ fn pair_images(
         }
     }
     let mut flags = vec![0u8; n_pix];
-    let l = g.lights[li];
+    let l = g.lights[li].direction().expect("DiLiGenT lights are directional");
     for k in 0..g.len() {
         let p = g.pixels[k] as usize;
         if !cap.mask[p] {

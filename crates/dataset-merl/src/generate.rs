@@ -10,7 +10,7 @@ use crate::error::Result;
 use crate::render::{GroundTruth, Sensor, render_light};
 use glam::{Mat3, Vec3};
 use mesh_encoding::TriMesh;
-use raycast_precompute::View;
+use raycast_precompute::{Light, View};
 use scene::manifest::{LightInfo, MANIFEST_FILE, Manifest, SceneStats, Split, ViewInfo};
 use scene::{MaterialSpec, PairImages, Progress, SceneConfig, SceneContents, UpAxis, write_scene};
 use std::path::{Path, PathBuf};
@@ -124,11 +124,23 @@ fn view_infos(config: &SceneConfig, views: &[View], is_train: &[bool]) -> Vec<Vi
                 .lights
                 .iter()
                 .enumerate()
-                .map(|(li, d)| LightInfo {
-                    direction: d.to_array(),
-                    intensity: s.light_intensity,
-                    split: split(li < s.train_lights),
-                    source_index: None,
+                .map(|(li, light)| match *light {
+                    Light::Directional(d) => LightInfo {
+                        direction: d.to_array(),
+                        intensity: s.light_intensity,
+                        split: split(li < s.train_lights),
+                        source_index: None,
+                        position: None,
+                    },
+                    // The orbit's point lights: radiant intensity E d^2 gives the configured
+                    // irradiance E at the origin.
+                    Light::Point(p) => LightInfo {
+                        direction: p.normalize_or(glam::Vec3::Z).to_array(),
+                        intensity: s.light_intensity.map(|e| e * p.length_squared()),
+                        split: split(li < s.train_lights),
+                        source_index: None,
+                        position: Some(p.to_array()),
+                    },
                 })
                 .collect(),
         })
@@ -151,13 +163,14 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
     let (label, gt) = ground_truth(config)?;
     let views = scene::orbit::orbit_views(s, config.seed)?;
     let is_train = train_views(s.views, s.train_views, config.seed);
+    let infos = view_infos(config, &views, &is_train);
     let contents = SceneContents {
         config,
         generator: format!("dataset-merl {}", env!("CARGO_PKG_VERSION")),
         label: label.clone(),
         mesh: &mesh,
         views: &views,
-        view_infos: view_infos(config, &views, &is_train),
+        view_infos: infos.clone(),
         clean_renders: true,
     };
     let mask = |_: usize, vp: &raycast_precompute::ViewPrecompute| {
@@ -173,8 +186,7 @@ pub fn generate_scene(config: &SceneConfig, out: &Path, progress: bool) -> Resul
             saturation: s.saturation,
             seed: config.seed ^ ((vi as u64) << 32 | li as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15),
         };
-        let direction = views[vi].lights[li].to_array();
-        let img = render_light(vp, li, direction, s.light_intensity, gt.as_ref(), sensor);
+        let img = render_light(vp, li, &infos[vi].lights[li], gt.as_ref(), sensor);
         let test_pair = !is_train[vi] && li >= s.train_lights;
         Ok(PairImages {
             observed: img.observed,

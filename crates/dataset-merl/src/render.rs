@@ -9,9 +9,10 @@
 //! that training and evaluation use. A model that returns the stored ground-truth BRDF
 //! therefore renders the scene's noise-free image bit for bit (its noise ceiling is exact).
 
-use raycast_precompute::{LightState, ViewPrecompute};
+use raycast_precompute::{Light, LightState, ViewPrecompute};
 use scene::flag;
-use scene::shading::{light_weight, shade};
+use scene::manifest::LightInfo;
+use scene::shading::{facing, light_at, light_weight, shade};
 
 /// The ground-truth BRDF: local-frame (l, v) to RGB in 1/sr, `None` where invalid.
 pub type GroundTruth<'a> = dyn Fn([f64; 3], [f64; 3]) -> Option<[f64; 3]> + Sync + 'a;
@@ -62,16 +63,17 @@ impl Normal {
     }
 }
 
-/// Renders light `light` of a view. `direction` is the light's direction as the scene's
-/// manifest records it (what training and evaluation shade with; the precompute holds a
-/// renormalised copy, which may differ in the last bit).
+/// Renders light `light` of a view. `info` is the light as the scene's manifest records it:
+/// shading uses its direction and irradiance, or a point light's per-sample direction and
+/// falloff ([`light_at`]), exactly as training and evaluation will (the precompute holds a
+/// renormalised copy of a direction, which may differ in the last bit; the lit/back-facing
+/// decision uses that copy, as it always has).
 // Channel loops index several per-channel arrays at once.
 #[allow(clippy::needless_range_loop)]
 pub fn render_light(
     view: &ViewPrecompute,
     light: usize,
-    direction: [f32; 3],
-    intensity: [f32; 3],
+    info: &LightInfo,
     gt: &GroundTruth<'_>,
     sensor: Sensor,
 ) -> LightImage {
@@ -83,21 +85,28 @@ pub fn render_light(
         flags: vec![0; n_pix],
     };
     let mut noise = Normal::new(sensor.seed);
-    let l_world = view.lights[light];
     for k in 0..view.len() {
         let p = view.pixels[k] as usize;
         let n = view.normals[k];
+        // What shading uses (the manifest's light), and the direction the lit decision uses.
+        let at = light_at(info, view.positions[k].to_array());
+        let l_world = match view.lights[light] {
+            Light::Directional(d) => Some(d.to_array()),
+            Light::Point(_) => at.map(|(l, _)| l),
+        };
         let frame = angles::Frame::from_normal([n.x as f64, n.y as f64, n.z as f64]);
-        let to_local = |w: glam::Vec3| frame.to_local([w.x as f64, w.y as f64, w.z as f64]);
-        let (l, v) = (to_local(l_world), to_local(view.view_dirs[k]));
+        let to_local = |w: [f32; 3]| frame.to_local(w.map(f64::from));
+        let v_world = view.view_dirs[k].to_array();
+        let above =
+            l_world.is_some_and(|l| facing(n.to_array(), l) && facing(n.to_array(), v_world));
         let mut radiance = [0.0_f32; 3];
-        let mut flags = match view.visibility.get(k, light) {
-            LightState::Lit if l[2] > 0.0 && v[2] > 0.0 => {
-                match gt(l, v) {
+        let mut flags = match (view.visibility.get(k, light), l_world, at) {
+            (LightState::Lit, Some(l_world), Some((direction, irradiance))) if above => {
+                match gt(to_local(l_world), to_local(v_world)) {
                     Some(f) => {
                         let f = f.map(|x| x as f32);
                         img.brdf[p] = f;
-                        if let Some(w) = light_weight(intensity, n.to_array(), direction) {
+                        if let Some(w) = light_weight(irradiance, n.to_array(), direction) {
                             radiance = shade(f, w);
                         }
                         flag::LIT | flag::GT_VALID
@@ -105,7 +114,7 @@ pub fn render_light(
                     None => flag::LIT, // invalid table entry: renders black
                 }
             }
-            LightState::Shadowed => flag::SHADOWED,
+            (LightState::Shadowed, ..) => flag::SHADOWED,
             _ => flag::BACK_FACING,
         };
         let mut saturated = false;

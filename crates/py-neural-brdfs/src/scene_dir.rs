@@ -149,15 +149,21 @@ impl Scene {
         Ok(d)
     }
 
-    /// Lights of a view: `{"direction": (L, 3), "intensity": (L, 3), "split": [str]}`.
+    /// Lights of a view: `{"direction": (L, 3), "intensity": (L, 3), "position": (L, 3),
+    /// "split": [str]}`; `position` is NaN for a directional light, and a point light's
+    /// `intensity` is its radiant intensity (E = I / d^2; the samples' `irradiance` has it
+    /// applied).
     fn lights<'py>(&self, py: Python<'py>, view: usize) -> PyResult<Bound<'py, PyDict>> {
         let v = self.view_info(view)?;
         let dirs: Vec<[f32; 3]> = v.lights.iter().map(|l| l.direction).collect();
         let int: Vec<[f32; 3]> = v.lights.iter().map(|l| l.intensity).collect();
+        let pos: Vec<[f32; 3]> =
+            v.lights.iter().map(|l| l.position.unwrap_or([f32::NAN; 3])).collect();
         let split: Vec<&str> = v.lights.iter().map(|l| split_name(l.split)).collect();
         let d = PyDict::new(py);
         d.set_item("direction", to_array2(py, &dirs))?;
         d.set_item("intensity", to_array2(py, &int))?;
+        d.set_item("position", to_array2(py, &pos))?;
         d.set_item("split", split)?;
         Ok(d)
     }

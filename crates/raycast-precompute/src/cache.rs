@@ -26,7 +26,7 @@ use crate::visibility::Visibility;
 
 /// Version of the cache format and of the precompute's semantics; bump on any change to either.
 /// 2: the payload is the serde encoding of [`ScenePrecompute`] (postcard).
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 
 /// The first 8 bytes of every ray-casting cache file.
 pub const MAGIC: &[u8; 8] = b"NBRDFRCP";
@@ -76,7 +76,18 @@ pub fn cache_key(mesh: &TriMesh, views: &[View], settings: &PrecomputeSettings) 
             }
         }
         put(&(v.lights.len() as u64).to_le_bytes());
-        v.lights.iter().for_each(|l| l.to_array().iter().for_each(|x| put(&x.to_le_bytes())));
+        for light in &v.lights {
+            // Directional lights hash as before; a point light's position follows a NaN marker
+            // that no valid direction has.
+            let p = match light {
+                crate::Light::Directional(d) => d,
+                crate::Light::Point(p) => {
+                    put(&f32::NAN.to_le_bytes());
+                    p
+                }
+            };
+            p.to_array().iter().for_each(|x| put(&x.to_le_bytes()));
+        }
     }
     match settings.shadow_bias {
         ShadowBias::Relative(f) => put(&[0].into_iter().chain(f.to_le_bytes()).collect::<Vec<_>>()),
@@ -162,7 +173,7 @@ mod tests {
         let positions = vec![Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::Y];
         let mesh = TriMesh::new(positions, vec![[0, 1, 2]]).unwrap();
         let camera = Camera::look_at(3.0 * Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0, 6, 5).unwrap();
-        let lights = vec![Vec3::Z, Vec3::new(0.6, 0.0, 0.8)];
+        let lights = vec![Vec3::Z.into(), Vec3::new(0.6, 0.0, 0.8).into()];
         let views = vec![View { camera, lights, mask: None }];
         let scene = precompute(&mesh, &views, &PrecomputeSettings::default()).unwrap();
         assert!(scene.views[0].pixels.len() > 3, "the seed covers some pixels");

@@ -32,7 +32,7 @@
 //!     vec![[0, 1, 2], [0, 2, 3]],
 //! )?;
 //! let camera = Camera::look_at(Vec3::new(0., 0., 3.), Vec3::ZERO, Vec3::Y, 30.0, 16, 16)?;
-//! let view = View { camera, lights: vec![Vec3::Z, -Vec3::Z], mask: None };
+//! let view = View { camera, lights: vec![Vec3::Z.into(), (-Vec3::Z).into()], mask: None };
 //! let scene = precompute(&quad, &[view], &PrecomputeSettings::default())?;
 //! let v = &scene.views[0];
 //! assert_eq!(v.len(), 16 * 16); // the quad fills the image
@@ -50,6 +50,7 @@ pub mod brute_force;
 pub mod cache;
 pub mod camera;
 pub mod error;
+pub mod light;
 pub mod packet;
 #[cfg(target_arch = "x86_64")]
 pub mod packet_closest;
@@ -64,6 +65,7 @@ pub use brute_force::BruteForce;
 pub use cache::{CacheOutcome, FORMAT_VERSION, cache_key, cache_path, precompute_cached};
 pub use camera::{Camera, intrinsics, mat3_from_rows};
 pub use error::{Error, Result};
+pub use light::Light;
 pub use packet::PACKET_SIZE;
 pub use precompute::{
     PrecomputeSettings, ScenePrecompute, ShadowBias, TraceStats, View, ViewPrecompute, precompute,

@@ -6,7 +6,9 @@
 //! (world space, unit, from the surface towards the light): if n.l <= 0 with n the interpolated
 //! vertex normal, the pair is back-facing and no ray is traced; otherwise a shadow ray starts at
 //! x + eps n_g, with n_g the geometric normal turned towards the camera and eps the shadow bias,
-//! and any hit marks the pair shadowed. No interreflection (spec section 6).
+//! and any hit marks the pair shadowed. A point light's direction l is taken per pixel, from the
+//! shadow-ray origin to the light, and its shadow ray ends at the light. No interreflection
+//! (spec section 6).
 //!
 //! The result is stored struct-of-arrays per view (see [`ViewPrecompute`]).
 
@@ -16,17 +18,18 @@ use rayon::prelude::*;
 
 use crate::camera::Camera;
 use crate::error::{Error, Result};
+use crate::light::Light;
 use crate::shadows::{TILE, Traversal, tile_rows, trace_shadows};
 use crate::tracer::{Hit, Tracer};
 use crate::visibility::Visibility;
 
-/// One view of a scene: a camera, its light directions and an optional foreground mask.
+/// One view of a scene: a camera, its lights and an optional foreground mask.
 #[derive(Debug, Clone, PartialEq)]
 pub struct View {
     /// The camera.
     pub camera: Camera,
-    /// Light directions in world space, from the surface towards the light; normalised on use.
-    pub lights: Vec<Vec3>,
+    /// The lights, in world space (directions normalised on use).
+    pub lights: Vec<Light>,
     /// Optional mask, row-major, `width * height` entries: only pixels marked true are traced.
     pub mask: Option<Vec<bool>>,
 }
@@ -75,8 +78,8 @@ pub struct ViewPrecompute {
     pub normals: Vec<Vec3>,
     /// Unit direction from the hit towards the camera centre.
     pub view_dirs: Vec<Vec3>,
-    /// The view's unit light directions (world space, towards the light).
-    pub lights: Vec<Vec3>,
+    /// The view's lights (world space; directions unit, towards the light).
+    pub lights: Vec<Light>,
     /// Per (foreground pixel, light) visibility.
     pub visibility: Visibility,
 }
@@ -115,8 +118,8 @@ pub struct ScenePrecompute {
     pub stats: TraceStats,
 }
 
-/// Checks the views and returns their unit light lists.
-pub(crate) fn validate_views(views: &[View]) -> Result<Vec<Vec<Vec3>>> {
+/// Checks the views and returns their light lists, directions normalised.
+pub(crate) fn validate_views(views: &[View]) -> Result<Vec<Vec<Light>>> {
     views
         .iter()
         .enumerate()
@@ -136,10 +139,15 @@ pub(crate) fn validate_views(views: &[View]) -> Result<Vec<Vec<Vec3>>> {
             v.lights
                 .iter()
                 .enumerate()
-                .map(|(l, d)| {
-                    d.try_normalize().ok_or_else(|| Error::View {
+                .map(|(l, light)| {
+                    light.validated().ok_or_else(|| Error::View {
                         view: i,
-                        message: format!("light {l} direction {d} is not a finite non-zero vector"),
+                        message: match light {
+                            Light::Directional(d) => {
+                                format!("light {l} direction {d} is not a finite non-zero vector")
+                            }
+                            Light::Point(p) => format!("light {l} position {p} is not finite"),
+                        },
                     })
                 })
                 .collect()
@@ -196,11 +204,11 @@ pub fn precompute_with_traversal(
     Ok(precompute_with(tracer, views, &lights, settings, traversal))
 }
 
-/// The precompute on a built tracer with validated, unit lights.
+/// The precompute on a built tracer with validated lights.
 pub(crate) fn precompute_with(
     tracer: &Tracer,
     views: &[View],
-    lights: &[Vec<Vec3>],
+    lights: &[Vec<Light>],
     settings: &PrecomputeSettings,
     traversal: Traversal,
 ) -> ScenePrecompute {
@@ -288,7 +296,7 @@ fn trace_view(
     tracer: &Tracer,
     vertex_normals: &[Vec3],
     view: &View,
-    lights: &[Vec3],
+    lights: &[Light],
     bias: f32,
     traversal: Traversal,
 ) -> (ViewPrecompute, TraceStats) {

@@ -27,6 +27,7 @@ pub fn orbit_views(
             let camera =
                 Camera::look_at(distance * dir, Vec3::ZERO, Vec3::Z, fov_y_deg, width, height)?;
             let lights = cone_directions(dir, lights, 60.0, || rng.next_f32());
+            let lights = lights.into_iter().map(crate::Light::Directional).collect();
             Ok(View { camera, lights, mask: None })
         })
         .collect()
@@ -83,7 +84,7 @@ mod tests {
         for v in &views {
             let to_cam = v.camera.center().normalize();
             assert_eq!(v.lights.len(), 42);
-            assert!(v.lights.iter().all(|l| l.dot(to_cam) >= 0.5 - 1e-5));
+            assert!(v.lights.iter().all(|l| l.direction().unwrap().dot(to_cam) >= 0.5 - 1e-5));
         }
         assert_eq!(views, orbit_views(20, 42, (64, 48), 3.0, 40.0, 1).unwrap());
         assert!(orbit_views(2, 1, (64, 64), 3.0, 190.0, 1).is_err());

@@ -10,6 +10,7 @@
 //! * [`Traversal::OneByOne`]: the simple reference, each pair traced alone with
 //!   [`Tracer::occluded`], pixels in parallel.
 
+use crate::light::Light;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -33,7 +34,7 @@ pub enum Traversal {
 
 /// Shadow rays of one view. `origins`, `normals` and `pixels` describe the foreground pixels
 /// (shadow-ray origin, interpolated normal, row-major pixel index in an image `width` wide);
-/// `lights` are unit directions. Returns the visibility and the numbers of traced and skipped
+/// `lights` are validated (unit directions). Returns the visibility and the numbers of traced and skipped
 /// (back-facing) pairs.
 pub(crate) fn trace_shadows(
     tracer: &Tracer,
@@ -41,7 +42,7 @@ pub(crate) fn trace_shadows(
     normals: &[Vec3],
     pixels: &[u32],
     width: u32,
-    lights: &[Vec3],
+    lights: &[Light],
     traversal: Traversal,
 ) -> (Visibility, u64, u64) {
     let mut visibility = Visibility::new(origins.len(), lights.len());
@@ -61,7 +62,7 @@ fn one_by_one(
     tracer: &Tracer,
     origins: &[Vec3],
     normals: &[Vec3],
-    lights: &[Vec3],
+    lights: &[Light],
     visibility: &mut Visibility,
 ) -> (u64, u64) {
     let wpp = Visibility::words_for(lights.len());
@@ -72,14 +73,18 @@ fn one_by_one(
         .zip(origins.par_iter().zip(normals))
         .map(|((lit, front), (origin, normal))| {
             let (mut traced, mut skip) = (0u64, 0u64);
-            for (l, dir) in lights.iter().enumerate() {
-                if normal.dot(*dir) <= 0.0 {
+            for (l, light) in lights.iter().enumerate() {
+                let Some((dir, t_max)) = light.toward(*origin) else {
+                    skip += 1;
+                    continue;
+                };
+                if normal.dot(dir) <= 0.0 {
                     skip += 1;
                     continue;
                 }
                 traced += 1;
                 front[l / 64] |= 1 << (l % 64);
-                if !tracer.occluded(*origin, *dir, f32::INFINITY) {
+                if !tracer.occluded(*origin, dir, t_max) {
                     lit[l / 64] |= 1 << (l % 64);
                 }
             }
@@ -123,7 +128,7 @@ fn packets(
     normals: &[Vec3],
     pixels: &[u32],
     width: u32,
-    lights: &[Vec3],
+    lights: &[Light],
     visibility: &mut Visibility,
 ) -> (u64, u64) {
     let wpp = Visibility::words_for(lights.len());
@@ -138,8 +143,23 @@ fn packets(
             let mut traced = 0u64;
             let mut packet = [Vec3::ZERO; PACKET_SIZE];
             let mut slot = [0usize; PACKET_SIZE];
-            for (l, dir) in lights.iter().enumerate() {
+            for (l, light) in lights.iter().enumerate() {
                 let (word, bit) = (l / 64, 1u64 << (l % 64));
+                let Light::Directional(dir) = light else {
+                    // A point light: a direction per pixel, each ray alone, ending at the light.
+                    for (j, &h) in members.iter().enumerate() {
+                        let origin = origins[h as usize];
+                        let Some((d, t_max)) = light.toward(origin) else { continue };
+                        if normals[h as usize].dot(d) > 0.0 {
+                            front[j * wpp + word] |= bit;
+                            traced += 1;
+                            if !tracer.occluded(origin, d, t_max) {
+                                lit[j * wpp + word] |= bit;
+                            }
+                        }
+                    }
+                    continue;
+                };
                 let mut k = 0;
                 for (j, &h) in members.iter().enumerate() {
                     if normals[h as usize].dot(*dir) > 0.0 {

@@ -40,7 +40,7 @@ fn sphere_casts_the_analytic_shadow_on_the_plane() {
         160,
     )
     .unwrap();
-    let view = View { camera, lights: vec![l, below], mask: None };
+    let view = View { camera, lights: vec![l.into(), below.into()], mask: None };
     let scene = precompute(&mesh, &[view], &PrecomputeSettings::default()).unwrap();
     let v = &scene.views[0];
     let plane_first = mesh.triangle_count() as u32 - 2;
@@ -105,7 +105,7 @@ fn default_bias_prevents_acne_and_is_relative_to_scene_size() {
     let camera =
         Camera::look_at(Vec3::new(0.0, -3.0, 6.0), Vec3::new(2.5, 2.5, 0.0), Vec3::Z, 30.0, 96, 96)
             .unwrap();
-    let view = View { camera, lights: vec![l], mask: None };
+    let view = View { camera, lights: vec![l.into()], mask: None };
     let scene =
         precompute(&mesh, std::slice::from_ref(&view), &PrecomputeSettings::default()).unwrap();
     assert!((scene.shadow_bias - 1e-4 * mesh.diagonal()).abs() < 1e-9);

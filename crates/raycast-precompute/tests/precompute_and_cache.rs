@@ -22,7 +22,7 @@ fn views() -> Vec<View> {
             let eye = 3.0 * rng.direction();
             let up = if eye.normalize().z.abs() > 0.9 { Vec3::X } else { Vec3::Z };
             let camera = Camera::look_at(eye, Vec3::ZERO, up, 45.0, 40, 30).unwrap();
-            let lights = (0..70).map(|_| rng.direction()).collect();
+            let lights = (0..70).map(|_| rng.direction().into()).collect();
             View { camera, lights, mask: None }
         })
         .collect()
@@ -72,7 +72,7 @@ fn layout_is_consistent_and_masks_restrict_tracing() {
     }
     // Bad inputs are errors naming the view.
     let mut bad = views.clone();
-    bad[1].lights[4] = Vec3::ZERO;
+    bad[1].lights[4] = Vec3::ZERO.into();
     let e = precompute(&mesh, &bad, &settings).unwrap_err().to_string();
     assert!(e.contains("view 1") && e.contains("light 4"), "{e}");
     let mut bad = views;
@@ -140,7 +140,9 @@ fn cache_miss_hit_corruption_and_keys() {
     moved.positions[0].x += 1e-6;
     assert_ne!(key, cache_key(&moved, &views, &settings));
     let mut relit = views.clone();
-    relit[0].lights[0].y += 1e-6;
+    if let raycast_precompute::Light::Directional(d) = &mut relit[0].lights[0] {
+        d.y += 1e-6;
+    }
     assert_ne!(key, cache_key(&mesh, &relit, &settings));
     let area = PrecomputeSettings { normal_weighting: NormalWeighting::Area, ..settings };
     assert_ne!(key, cache_key(&mesh, &views, &area));
@@ -159,7 +161,7 @@ fn shared_mesh_from_two_file_names_shares_one_cache_entry() {
     let a = mesh_encoding::load_mesh(data.join("meshes/spot.obj"), &options).unwrap().mesh;
     let b = mesh_encoding::load_mesh(&copy, &options).unwrap().mesh;
     let cam = Camera::look_at(Vec3::new(0.0, -3.0, 0.5), Vec3::ZERO, Vec3::Z, 40.0, 8, 8).unwrap();
-    let views = vec![View { camera: cam, lights: vec![Vec3::Z], mask: None }];
+    let views = vec![View { camera: cam, lights: vec![Vec3::Z.into()], mask: None }];
     let cache = dir.join("cache");
     let s = PrecomputeSettings::default();
     assert_eq!(precompute_cached(&a, &views, &s, &cache).unwrap().1, CacheOutcome::Miss);

@@ -59,6 +59,7 @@ pub enum MaterialSpec {
 /// | `lookup` | nearest-lower | MERL lookup rule |
 /// | `shadow_bias_relative` | 1e-4 | shadow-ray offset as a fraction of the mesh diagonal |
 /// | `up_axis` | y | the mesh's up axis; the mesh is rotated so that it points to +z, the orbit's up |
+/// | `point_light_distance` | none | point lights instead of directional ones: each light at this distance from the origin along its rig direction, with radiant intensity `light_intensity` x distance^2 (the irradiance at the origin is `light_intensity`) |
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SceneSettings {
@@ -90,6 +91,10 @@ pub struct SceneSettings {
     pub shadow_bias_relative: f32,
     /// The mesh's up axis (the common test meshes are y-up).
     pub up_axis: UpAxis,
+    /// Point lights at this distance from the origin instead of directional lights (absent:
+    /// directional, and absent from the configurations written before it existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point_light_distance: Option<f32>,
 }
 
 /// Which mesh axis points up.
@@ -138,6 +143,7 @@ impl Default for SceneSettings {
             lookup: Lookup::NearestLower,
             shadow_bias_relative: 1e-4,
             up_axis: UpAxis::Y,
+            point_light_distance: None,
         }
     }
 }
@@ -217,6 +223,14 @@ impl SceneConfig {
             return bad(
                 "settings.shadow_bias_relative",
                 format!("{} is not in [0, 0.1)", s.shadow_bias_relative),
+            );
+        }
+        if let Some(d) = s.point_light_distance
+            && !(d > 1.0 && d.is_finite())
+        {
+            return bad(
+                "settings.point_light_distance",
+                format!("{d} must exceed 1 (the mesh's radius) and be finite"),
             );
         }
         if let MaterialSpec::Lambert { albedo } = &self.material

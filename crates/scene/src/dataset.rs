@@ -8,8 +8,9 @@
 use crate::error::{Error, Result};
 use crate::flag;
 use crate::images;
-use crate::manifest::{MANIFEST_FILE, Manifest, Split};
+use crate::manifest::{LightInfo, MANIFEST_FILE, Manifest, Split};
 use crate::mesh_file;
+use crate::shading::light_at;
 use crate::writer::sample_stem;
 use glam::Vec3;
 use mesh_encoding::TriMesh;
@@ -54,7 +55,8 @@ pub struct SampleSet {
     pub l: Vec<[f32; 3]>,
     /// Unit direction to the camera.
     pub v: Vec<[f32; 3]>,
-    /// Light irradiance E (RGB); the rendering is L = f E cos(theta_l).
+    /// Light irradiance E (RGB) at the sample (a point light's falls off with the square of
+    /// its distance); the rendering is L = f E cos(theta_l).
     pub irradiance: Vec<[f32; 3]>,
     /// Observed radiance.
     pub observed: Vec<[f32; 3]>,
@@ -111,7 +113,7 @@ impl SceneDataset {
                     s.width,
                     s.height,
                 )?;
-                let lights = v.lights.iter().map(|l| Vec3::from_array(l.direction)).collect();
+                let lights = v.lights.iter().map(LightInfo::source).collect();
                 Ok(View { camera, lights, mask: None })
             })
             .collect::<Result<Vec<_>>>()?;
@@ -220,6 +222,9 @@ impl SceneDataset {
             if f & flag::LIT == 0 {
                 continue;
             }
+            let Some((l, irradiance)) = light_at(light, g.positions[k].to_array()) else {
+                continue; // a point light at the surface point itself: never lit
+            };
             s.view.push(vi as u16);
             s.light.push(li as u16);
             s.pixel.push(p as u32);
@@ -227,9 +232,9 @@ impl SceneDataset {
             s.barycentric.push(g.barycentrics[k]);
             s.position.push(g.positions[k].to_array());
             s.normal.push(g.normals[k].to_array());
-            s.l.push(light.direction);
+            s.l.push(l);
             s.v.push(g.view_dirs[k].to_array());
-            s.irradiance.push(light.intensity);
+            s.irradiance.push(irradiance);
             s.observed.push(observed[p]);
             s.gt_brdf.push(brdf[p]);
             s.gt_valid.push(f & flag::GT_VALID != 0);

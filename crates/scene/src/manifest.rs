@@ -28,13 +28,15 @@ pub enum Split {
     Test,
 }
 
-/// One directional light of a view.
+/// One light of a view: directional, or a point light when `position` is set.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LightInfo {
-    /// Unit world direction from the surface towards the light.
+    /// Unit world direction from the surface towards the light. For a point light, the
+    /// direction from the scene's centre towards it (for display; shading uses the position).
     pub direction: [f32; 3],
-    /// Irradiance, RGB.
+    /// Directional light: irradiance E, RGB. Point light: radiant intensity I, RGB, so that a
+    /// point at distance d receives E = I / d^2 ([`crate::shading::light_at`]).
     pub intensity: [f32; 3],
     /// Split of this light within its view.
     pub split: Split,
@@ -42,6 +44,20 @@ pub struct LightInfo {
     /// generated scenes, whose manifests are unchanged by this field).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub source_index: Option<u32>,
+    /// A point light's world position (absent for a directional light, and in every manifest
+    /// written before point lights existed, which are unchanged by this field).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position: Option<[f32; 3]>,
+}
+
+impl LightInfo {
+    /// The light as ray casting needs it.
+    pub fn source(&self) -> raycast_precompute::Light {
+        match self.position {
+            Some(p) => raycast_precompute::Light::Point(glam::Vec3::from_array(p)),
+            None => raycast_precompute::Light::Directional(glam::Vec3::from_array(self.direction)),
+        }
+    }
 }
 
 /// One camera view.

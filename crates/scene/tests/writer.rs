@@ -38,7 +38,7 @@ fn pair(li: usize, g: &ViewPrecompute) -> scene::Result<PairImages> {
                 let w = scene::shading::light_weight(
                     [1.0; 3],
                     g.normals[k].to_array(),
-                    g.lights[li].to_array(),
+                    g.lights[li].direction().expect("directional").to_array(),
                 );
                 img.observed[p] = scene::shading::shade(f, w.unwrap_or([0.0; 3]));
                 img.brdf[p] = f;
@@ -58,7 +58,7 @@ fn a_written_scene_reads_back_with_its_statistics_and_splits() {
     let mesh = quad();
     let camera =
         Camera::look_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y, 30.0, 16, 16).unwrap();
-    let views = vec![View { camera, lights: vec![Vec3::Z, -Vec3::Z], mask: None }];
+    let views = vec![View { camera, lights: vec![Vec3::Z.into(), (-Vec3::Z).into()], mask: None }];
     let settings = SceneSettings {
         width: 16,
         height: 16,
@@ -82,6 +82,7 @@ fn a_written_scene_reads_back_with_its_statistics_and_splits() {
         intensity: [1.0; 3],
         split,
         source_index: None,
+        position: None,
     };
     let view_infos = vec![ViewInfo {
         split: Split::Train,

@@ -152,16 +152,26 @@ pub fn write(
     stdx::fs::write_atomic(&dir.join("object.xml"), object.as_bytes())?;
     let mut files = vec!["mesh.ply".to_string(), "object.xml".to_string()];
     for p in pairs {
-        let d = p.direction.map(|x| -x as f64);
         let e = p.irradiance.map(f64::from);
+        let emitter = match p.position {
+            // Mitsuba 3's point emitter: radiant intensity, inverse-square falloff.
+            Some(q) => format!(
+                "<emitter type=\"point\">\n        <point name=\"position\" value=\"{}\"/>\n        \
+                 <rgb name=\"intensity\" value=\"{}\"/>\n    </emitter>",
+                rgb_value(q.map(f64::from)),
+                rgb_value(e)
+            ),
+            None => format!(
+                "<emitter type=\"directional\">\n        <vector name=\"direction\" value=\"{}\"/>\n        \
+                 <rgb name=\"irradiance\" value=\"{}\"/>\n    </emitter>",
+                rgb_value(p.direction.map(|x| -x as f64)),
+                rgb_value(e)
+            ),
+        };
         let xml = format!(
             "<scene version=\"3.0.0\">\n    <integrator type=\"direct\"/>\n{}    \
-             <emitter type=\"directional\">\n        <vector name=\"direction\" value=\"{}\"/>\n        \
-             <rgb name=\"irradiance\" value=\"{}\"/>\n    </emitter>\n    \
-             <include filename=\"object.xml\"/>\n</scene>\n",
+             {emitter}\n    <include filename=\"object.xml\"/>\n</scene>\n",
             sensor_xml(&p.camera, SAMPLES_PER_PIXEL),
-            rgb_value(d),
-            rgb_value(e)
         );
         let name = format!("{}.xml", p.stem());
         stdx::fs::write_atomic(&dir.join(&name), xml.as_bytes())?;

@@ -123,10 +123,13 @@ pub struct ExportPair {
     pub light: usize,
     /// The view's camera.
     pub camera: ExportCamera,
-    /// Unit world direction from the surface towards the light.
+    /// Unit world direction from the surface towards the light (a point light: from the scene's
+    /// centre, for display).
     pub direction: [f32; 3],
-    /// Irradiance on a surface facing the light, RGB.
+    /// Irradiance on a surface facing the light, RGB (a point light: its radiant intensity).
     pub irradiance: [f32; 3],
+    /// A point light's position (None: directional).
+    pub position: Option<[f32; 3]>,
 }
 
 impl ExportPair {
@@ -168,6 +171,7 @@ pub fn test_pairs(scene: &SceneDataset) -> Vec<ExportPair> {
                 },
                 direction: light.direction,
                 irradiance: light.intensity,
+                position: light.position,
             }
         })
         .collect()

@@ -113,21 +113,27 @@ pub fn write(
     stdx::fs::write_atomic(&dir.join("object.pbrt"), object.as_bytes())?;
     let mut files = vec!["mesh.ply".to_string(), "object.pbrt".to_string()];
     for p in pairs {
-        let d = p.direction;
         let e = p.irradiance;
+        let light = match p.position {
+            // pbrt-v4's point light: radiant intensity I, inverse-square falloff.
+            Some(q) => format!(
+                "LightSource \"point\" \"point3 from\" [ {} {} {} ]\n    \"rgb I\" [ {} {} {} ]\n",
+                q[0], q[1], q[2], e[0], e[1], e[2]
+            ),
+            None => {
+                let d = p.direction;
+                format!(
+                    "LightSource \"distant\" \"point3 from\" [ {} {} {} ] \"point3 to\" [ 0 0 0 ]\n    \"rgb L\" [ {} {} {} ]\n",
+                    d[0], d[1], d[2], e[0], e[1], e[2]
+                )
+            }
+        };
         let text = format!(
             "{}    \"string filename\" \"{}.exr\"\nSampler \"independent\" \"integer pixelsamples\" 64\n\
-             Integrator \"path\" \"integer maxdepth\" 1\nWorldBegin\n\
-             LightSource \"distant\" \"point3 from\" [ {} {} {} ] \"point3 to\" [ 0 0 0 ]\n    \"rgb L\" [ {} {} {} ]\n\
+             Integrator \"path\" \"integer maxdepth\" 1\nWorldBegin\n{light}\
              Include \"object.pbrt\"\n",
             camera_block(&p.camera),
             p.stem(),
-            d[0],
-            d[1],
-            d[2],
-            e[0],
-            e[1],
-            e[2]
         );
         let name = format!("{}.pbrt", p.stem());
         stdx::fs::write_atomic(&dir.join(&name), text.as_bytes())?;
