@@ -10,7 +10,7 @@
 
 use crate::additive_separate::{AdditiveSeparate, additive_separate_configs};
 use crate::additive_shared::{AdditiveShared, additive_shared_configs};
-use crate::batch::BrdfBatch;
+use crate::batch::{BrdfBatch, Samples};
 use crate::features::AngleConfig;
 use crate::mlp::MlpConfig;
 use crate::output::{AdditiveHead, BrdfOutput};
@@ -264,8 +264,49 @@ impl ModelConfig {
     }
 
     /// Builds the model on `device` (use an autodiff device for training), its parameter ids
-    /// numbered deterministically ([`crate::param_ids`]).
+    /// numbered deterministically ([`crate::param_ids`]), its initial weights drawn from the
+    /// backend's random generator as it stands (a fit uses [`ModelConfig::init_seeded`]).
     pub fn init(&self, device: &Device) -> Result<BrdfModel> {
+        let _draws = initial_draws();
+        let model = self.init_drawn(device)?;
+        model.visit(&mut Materialize);
+        Ok(model)
+    }
+
+    /// The model a fit starts from: the backend's generator seeded with `seed`, the output
+    /// biases set for `initial_brdf` ([`BrdfModel::with_initial_brdf`]) where given. The same
+    /// seed gives the same initial weights whatever other threads of the process do.
+    ///
+    /// burn keeps one random generator per backend for the whole process, and a parameter
+    /// draws its initial values from it lazily, when it is first read. Seeding, building and
+    /// training one after the other thus let a model built or trained on another thread in
+    /// between (two fits in one process, the tests of one binary) take some of the draws: the
+    /// weights, and the whole fit, depended on the timing of the threads. Here the seed and
+    /// every draw happen under one process-wide lock, which [`ModelConfig::init`] takes as
+    /// well, in the order a fit has always drawn them (the output biases, then the
+    /// parameters as a forward pass reads them), so fits keep their weights to the bit.
+    pub fn init_seeded(
+        &self,
+        device: &Device,
+        seed: u64,
+        initial_brdf: Option<[f32; 3]>,
+    ) -> Result<BrdfModel> {
+        let _draws = initial_draws();
+        device.seed(seed);
+        let mut model = self.init_drawn(device)?;
+        if let Some(f0) = initial_brdf {
+            model = model.with_initial_brdf(f0);
+        }
+        let n = [[0.0, 0.0, 1.0_f32]];
+        let spatial = vec![0.0; self.spatial_dim];
+        let one = Samples { spatial: &spatial, l: &n, v: &n };
+        drop(model.forward(&self.batch(&one, None, device)?));
+        model.visit(&mut Materialize);
+        Ok(model)
+    }
+
+    /// The model, its parameters not yet drawn (burn draws a parameter when it is first read).
+    fn init_drawn(&self, device: &Device) -> Result<BrdfModel> {
         self.validate()?;
         let mut mlps = self.mlp_configs().into_iter().map(|m| m.init(device));
         let mut next = || mlps.next().expect("MLP count");
@@ -289,6 +330,25 @@ impl ModelConfig {
             }
         }))
     }
+}
+
+/// Reads every parameter once, so that any not yet drawn is drawn now.
+struct Materialize;
+
+impl burn::module::ModuleVisitor for Materialize {
+    fn visit_float<const D: usize>(
+        &mut self,
+        param: &burn::module::Param<burn::tensor::Tensor<D>>,
+    ) {
+        drop(param.val());
+    }
+}
+
+/// The process-wide lock under which initial weights are drawn from burn's generator.
+fn initial_draws() -> std::sync::MutexGuard<'static, ()> {
+    static DRAWS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    // A panic while drawing leaves nothing to repair: the next seed restarts the generator.
+    DRAWS.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 /// Any model of the comparison.
@@ -326,6 +386,53 @@ impl BrdfModel {
             BrdfModel::SingleMlp(m) => m.forward(batch.spatial.clone(), angles()),
             BrdfModel::AdditiveSeparate(m) => m.forward(batch.spatial.clone(), angles()),
             BrdfModel::AdditiveShared(m) => m.forward(batch.spatial.clone(), angles()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use burn::module::{ModuleVisitor, Param};
+    use burn::tensor::Tensor;
+
+    struct Values(Vec<Vec<f32>>);
+
+    impl ModuleVisitor for Values {
+        fn visit_float<const D: usize>(&mut self, param: &Param<Tensor<D>>) {
+            self.0.push(param.val().into_data().convert::<f32>().try_into_vec::<f32>().unwrap());
+        }
+    }
+
+    fn values(model: &BrdfModel) -> Vec<Vec<f32>> {
+        let mut v = Values(Vec::new());
+        model.visit(&mut v);
+        v.0
+    }
+
+    /// `init_seeded` draws what a fit drew before it existed (seed, build, set the output
+    /// biases, train: every parameter drawn when first read), so fits keep their weights.
+    #[test]
+    fn seeded_init_draws_what_a_fit_drew_before() {
+        let device = crate::device::cpu_training();
+        for kind in ModelKind::ALL {
+            let c = ModelConfig { kind, spatial_dim: 3, ..ModelConfig::default() };
+            for f0 in [None, Some([0.2, 0.3, 0.4])] {
+                let got = values(&c.init_seeded(&device, 9, f0).unwrap());
+                // The old sequence, on a batch of two real samples.
+                let _draws = initial_draws();
+                device.seed(9);
+                let mut old = c.init_drawn(&device).unwrap();
+                if let Some(f0) = f0 {
+                    old = old.with_initial_brdf(f0);
+                }
+                let (l, v) =
+                    ([[0.3, 0.1, 0.95], [0.0, 0.6, 0.8]], [[0.0, 0.0, 1.0], [0.5, 0.0, 0.87]]);
+                let spatial = [0.1, -0.4, 0.7, 0.2, 0.0, -0.9];
+                let s = Samples { spatial: &spatial, l: &l, v: &v };
+                drop(old.forward(&c.batch(&s, None, &device).unwrap()));
+                assert!(values(&old) == got, "{kind:?}, initial BRDF {f0:?}");
+            }
         }
     }
 }

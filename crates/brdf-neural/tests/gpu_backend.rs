@@ -70,8 +70,7 @@ fn every_model_kind_gives_the_cpus_values_and_gradients_on_the_gpu() {
     let gpu_device = gpu().training_device().expect("GPU backend built");
     for kind in ModelKind::ALL {
         let c = small(kind);
-        cpu.seed(11);
-        let model = c.init(&cpu).unwrap();
+        let model = c.init_seeded(&cpu, 11, None).unwrap();
         let on_gpu = model.clone().fork(&gpu_device);
         assert_eq!(parameters(&on_gpu), parameters(&model), "{kind:?}: copied parameters");
         let s = samples(&mut rng(3), 257, c.spatial_dim);
@@ -99,8 +98,7 @@ fn a_single_mlp_trains_along_the_same_loss_curve_on_the_gpu() {
         .collect();
     let cpu = brdf_neural::device::cpu_training();
     let gpu_device = gpu().training_device().unwrap();
-    cpu.seed(5);
-    let model = c.init(&cpu).unwrap();
+    let model = c.init_seeded(&cpu, 5, None).unwrap();
     let on_gpu = model.clone().fork(&gpu_device);
     let (_, l_cpu) = train(model, &c, &data, 30, 3e-3, &cpu);
     let (trained, l_gpu) = train(on_gpu, &c, &data, 30, 3e-3, &gpu_device);

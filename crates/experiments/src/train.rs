@@ -208,11 +208,8 @@ pub fn fit_and_keep(
     let t = &config.train;
 
     let device = options.backend.training_device()?;
-    device.seed(config.seed);
-    let mut model = config.model.init(&device)?;
-    if t.output_init == OutputInit::Data {
-        model = model.with_initial_brdf(data.mean_brdf());
-    }
+    let initial_brdf = (t.output_init == OutputInit::Data).then(|| data.mean_brdf());
+    let mut model = config.model.init_seeded(&device, config.seed, initial_brdf)?;
     let mut optim = AdamConfig::new().with_epsilon(t.adam_epsilon as f32).init();
     let mut state = CheckpointState::default();
     let last_checkpoint = checkpoint::latest(&dir)?;
