@@ -219,6 +219,9 @@ mod tests {
 
     #[test]
     fn param_count_matches_module_and_concatenation_form() {
+        // Its forward pass below draws the initial weights: under the lock the model tests of
+        // this binary compare their draws under.
+        let _draws = crate::model::initial_draws();
         let device = crate::device::cpu();
         let mut c = MlpConfig::new(10);
         c.width = 8;

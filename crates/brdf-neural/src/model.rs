@@ -344,8 +344,9 @@ impl burn::module::ModuleVisitor for Materialize {
     }
 }
 
-/// The process-wide lock under which initial weights are drawn from burn's generator.
-fn initial_draws() -> std::sync::MutexGuard<'static, ()> {
+/// The process-wide lock under which initial weights are drawn from burn's generator (a test
+/// that reads a lazily built [`crate::mlp::Mlp`] holds it too).
+pub(crate) fn initial_draws() -> std::sync::MutexGuard<'static, ()> {
     static DRAWS: std::sync::Mutex<()> = std::sync::Mutex::new(());
     // A panic while drawing leaves nothing to repair: the next seed restarts the generator.
     DRAWS.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
