@@ -16,7 +16,8 @@
 //! config.spatial_dim = 4;
 //! config.width = 16;
 //! let device = brdf_neural::device::cpu();
-//! let model = config.init(&device).unwrap();
+//! // Seeded: the same seed gives the same initial weights, whatever other threads do.
+//! let model = config.init_seeded(&device, 7, None).unwrap();
 //! let (l, v) = ([[0.0, 0.6, 0.8_f32]], [[0.0, -0.6, 0.8_f32]]);
 //! let samples = Samples { spatial: &[0.1, -0.2, 0.3, 0.0], l: &l, v: &v };
 //! let out = model.forward(&config.batch(&samples, None, &device).unwrap());
