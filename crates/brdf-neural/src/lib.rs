@@ -70,6 +70,7 @@
 pub mod additive_separate;
 pub mod additive_shared;
 pub mod batch;
+pub mod batch_split;
 pub mod device;
 mod error;
 pub mod features;

@@ -18,7 +18,11 @@
 //! The late input (`d_late > 0`) enters at layer `late_into`: with `late_into = 0` it is simply
 //! part of the raw input (and so of the skip), otherwise it is added to layer `late_into` only
 //! (the NOL ablation of the Single MLP feeds the directions in there).
+//!
+//! Every linear layer runs through [`crate::batch_split`], which splits the batch sum of the
+//! weight gradients into parts on GPU backends.
 
+use crate::batch_split::linear;
 use burn::module::Module;
 use burn::nn::{Linear, LinearConfig};
 use burn::tensor::activation::relu;
@@ -195,16 +199,16 @@ impl Mlp {
         };
         let mut h = raw.clone();
         for (k, layer) in self.layers.iter().enumerate() {
-            let mut z = layer.forward(h);
+            let mut z = linear(layer, h);
             if k == self.skip_into
                 && let Some(skip) = &self.skip
             {
-                z = z + skip.forward(raw.clone());
+                z = z + linear(skip, raw.clone());
             }
             if k == self.late_into
                 && let (Some(proj), Some(l)) = (&self.late, late.take())
             {
-                z = z + proj.forward(l);
+                z = z + linear(proj, l);
             }
             h = if k < self.hidden_layers { relu(z) } else { z };
         }

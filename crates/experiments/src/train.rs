@@ -21,7 +21,7 @@ use crate::run_dir::{RunDir, RunMetrics};
 use crate::train_config::OutputInit;
 use crate::trainer::{Loop, LoopEnd, gamma_mse, save_weights};
 use crate::{Error, Result};
-use brdf_neural::BrdfModel;
+use brdf_neural::{BrdfModel, batch_split};
 use burn::module::Module;
 use burn::optim::AdamConfig;
 use burn::tensor::Device;
@@ -221,9 +221,13 @@ pub fn fit_and_keep(
     let lp = Loop { config, run: &dir, data: &data, val: &val, device, bar };
     // The matrix-product precision of this thread's training steps; evaluation keeps f32.
     let precision = t.matmul_precision.scope(options.backend)?;
+    // On a GPU, the weight gradients' sum over the batch is split into parts (split-K): the
+    // GPU's matrix-product kernels do not split it themselves. The CPU keeps the plain product.
+    let parts = if options.backend.is_gpu() { batch_split::gpu_parts(t.batch_size) } else { 1 };
+    let split = batch_split::scope(parts);
     let end =
         lp.run(model, &mut optim, state, last_checkpoint, options.hook, options.stop_after)?;
-    drop(precision);
+    drop((precision, split));
     let (model, state) = match end {
         LoopEnd::Done(done) => *done,
         LoopEnd::Interrupted(step) => return Ok((FitOutcome::Stopped(step), None)),

@@ -1,0 +1,136 @@
+//! Splitting a weight gradient's sum over the batch into parts (split-K), for GPU backends.
+//!
+//! A linear layer's weight gradient is `Xᵀ G`: a `[d_in, d_out]` result (128 x 128 for a
+//! hidden layer) whose every element is a sum over the whole batch (32,768 rows at the paper's
+//! budget). A matrix-product kernel without split-K (CubeCL's, as of 0.11) tiles only the output,
+//! so that product runs on a few dozen thread blocks of a GPU with 132 multiprocessors, each
+//! walking the 32,768 rows in one chain.
+//!
+//! Inside a [`scope`] of `parts > 1`, the network's linear layers compute `y = X W + b` as a
+//! batched product over `parts` blocks of rows, `y_p = X_p W + b`, with `W` broadcast: the
+//! forward value is the same product (backends fold a broadcast right operand into one
+//! product), and burn's autodiff turns the broadcast into `parts` independent products
+//! `X_pᵀ G_p` and one sum over the parts, the split-K schedule that cuBLAS picks for such shapes.
+//! Only the summation order of the weight gradients changes. Batches that `parts` does not
+//! divide, or with fewer than [`MIN_ROWS`] rows a part, keep the plain product.
+//!
+//! The setting is per thread, like [`crate::precision`]; the default (1 part) is the plain
+//! product, which keeps the CPU fits bit-identical to before. The experiments trainer turns it
+//! on for GPU backends ([`gpu_parts`]).
+
+use burn::nn::Linear;
+use burn::tensor::Tensor;
+use std::cell::Cell;
+
+/// The fewest rows a part may have; smaller parts would make the sum over the parts the cost.
+pub const MIN_ROWS: usize = 256;
+
+thread_local! {
+    static PARTS: Cell<usize> = const { Cell::new(1) };
+}
+
+/// Computes the linear layers the calling thread runs with their batch split into `parts`
+/// (1: the plain product) until the returned guard drops.
+pub fn scope(parts: usize) -> BatchSplitGuard {
+    BatchSplitGuard { previous: PARTS.with(|p| p.replace(parts.max(1))) }
+}
+
+/// The number of parts in effect on the calling thread.
+pub fn parts() -> usize {
+    PARTS.with(Cell::get)
+}
+
+/// The split a GPU training loop uses for a batch of `rows`: parts of 512 rows (64 parts at
+/// 2^15), at most 64 parts, and 1 where that does not divide the batch.
+pub fn gpu_parts(rows: usize) -> usize {
+    let parts = (rows / 512).clamp(1, 64);
+    if rows % parts == 0 { parts } else { 1 }
+}
+
+/// Restores the thread's previous split when dropped.
+#[must_use = "the split applies only while the guard lives"]
+pub struct BatchSplitGuard {
+    previous: usize,
+}
+
+impl Drop for BatchSplitGuard {
+    fn drop(&mut self) {
+        PARTS.with(|p| p.set(self.previous));
+    }
+}
+
+/// `layer` applied to `x` (`[rows, d_in]` to `[rows, d_out]`), split as the thread's
+/// [`scope`] says.
+pub(crate) fn linear(layer: &Linear, x: Tensor<2>) -> Tensor<2> {
+    let parts = parts();
+    let [rows, d_in] = x.dims();
+    if parts <= 1 || rows % parts != 0 || rows / parts < MIN_ROWS {
+        return layer.forward(x);
+    }
+    let weight = layer.weight.val();
+    let d_out = weight.dims()[1];
+    let y = x
+        .reshape([parts, rows / parts, d_in])
+        .matmul(weight.unsqueeze::<3>())
+        .reshape([rows, d_out]);
+    match &layer.bias {
+        Some(bias) => y + bias.val().unsqueeze::<2>(),
+        None => y,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use burn::nn::LinearConfig;
+    use burn::tensor::{Distribution, Tolerance};
+
+    #[test]
+    fn gpu_parts_divide_the_batch_into_parts_of_512_rows() {
+        assert_eq!(gpu_parts(32_768), 64);
+        assert_eq!(gpu_parts(8_192), 16);
+        assert_eq!(gpu_parts(65_536), 64);
+        assert_eq!(gpu_parts(300), 1);
+        assert_eq!(gpu_parts(1_536), 3);
+        assert_eq!(gpu_parts(1_600), 1); // 3 parts do not divide 1,600 rows
+    }
+
+    #[test]
+    fn the_scope_sets_and_restores_the_split() {
+        assert_eq!(parts(), 1);
+        {
+            let _outer = scope(8);
+            assert_eq!(parts(), 8);
+            {
+                let _inner = scope(0);
+                assert_eq!(parts(), 1);
+            }
+            assert_eq!(parts(), 8);
+        }
+        assert_eq!(parts(), 1);
+    }
+
+    #[test]
+    fn split_layers_give_the_plain_values_and_gradients() {
+        let device = crate::device::cpu().autodiff();
+        let layer = LinearConfig::new(5, 3).init(&device);
+        let x = Tensor::<2>::random([1_024, 5], Distribution::Normal(0.0, 1.0), &device);
+        let run = |parts: usize| {
+            let _split = scope(parts);
+            let y = linear(&layer, x.clone());
+            let grads = (y.clone() * y.clone()).sum().backward();
+            let gw = layer.weight.val().grad(&grads).expect("weight gradient");
+            let gb = layer.bias.as_ref().unwrap().val().grad(&grads).expect("bias gradient");
+            (y.inner(), gw, gb)
+        };
+        let (y1, gw1, gb1) = run(1);
+        let (y4, gw4, gb4) = run(4);
+        y4.into_data().assert_approx_eq::<f32>(&y1.into_data(), Tolerance::default());
+        gw4.into_data().assert_approx_eq::<f32>(&gw1.into_data(), Tolerance::default());
+        gb4.into_data().assert_approx_eq::<f32>(&gb1.into_data(), Tolerance::default());
+        // Too few rows a part: the plain product, to the bit.
+        let (y8, gw8, _) = run(8);
+        assert_eq!(y8.into_data(), run(1).0.into_data());
+        assert_eq!(gw8.into_data(), run(1).1.into_data());
+    }
+}
