@@ -17,7 +17,12 @@
 //! - `BRDF_KEEP_MALLOC=0` turns the host-memory policy off (`brdf_neural::host_memory`);
 //! - `BRDF_BENCH_PRECISION=f32,bf16` (default `f32`) also times every step with bf16 matrix
 //!   products ([`brdf_neural::precision`], flex only), with the PyTorch comparison under bf16
-//!   autocast, and the flex products themselves in both precisions.
+//!   autocast, and the flex products themselves in both precisions;
+//! - `BRDF_BENCH_SPLIT=1,64` times every step with its linear layers' batch split into these
+//!   numbers of parts ([`brdf_neural::batch_split`]; default: what the trainer uses, 1 on the
+//!   CPU and [`brdf_neural::batch_split::gpu_parts`] on a GPU), and, on a GPU backend, prints
+//!   the times of one 128-wide layer's three products alone (forward, input gradient, weight
+//!   gradient plain and split).
 //!
 //! Criterion's filter (e.g. `-- single_mlp`) selects the criterion groups only; the summary
 //! always times every model: median step time of 7, samples/s, and the achieved GFLOP/s
@@ -41,6 +46,7 @@
 //! (stock burn-flex 0.22.1, glibc defaults) the same step took 298 to 311 ms against PyTorch's
 //! 225 to 235 ms (ratio 1.3).
 
+use brdf_neural::batch_split;
 use brdf_neural::device::Backend;
 use brdf_neural::mlp::MlpConfig;
 use brdf_neural::precision::MatmulPrecision;
@@ -100,10 +106,17 @@ struct Step {
     device: Device,
     backend: Backend,
     precision: MatmulPrecision,
+    /// Parts the linear layers' batch is split into ([`batch_split`]).
+    split: usize,
 }
 
 impl Step {
-    fn new(c: &ModelConfig, backend: Backend, precision: MatmulPrecision, n: usize) -> Self {
+    fn new(
+        c: &ModelConfig,
+        backend: Backend,
+        (precision, split): (MatmulPrecision, usize),
+        n: usize,
+    ) -> Self {
         let device = &backend.training_device().expect("backend built");
         device.seed(1);
         let mut state = 0x2545_f491_4f6c_dd1d_u64;
@@ -134,12 +147,14 @@ impl Step {
             device: device.clone(),
             backend,
             precision,
+            split,
         }
     }
 
     /// Forward, radiance L = f * (E shadow cos), MSE, backward, Adam; waits for the device.
     fn run(&mut self) {
         let _precision = self.precision.scope(self.backend).expect("precision on this backend");
+        let _split = batch_split::scope(self.split);
         let model = self.model.take().expect("model");
         let out = model.forward(&self.batch);
         let loss = (out.f * self.weight.clone() - self.target.clone()).square().mean();
@@ -308,20 +323,23 @@ fn bench(cr: &mut Criterion) {
     let quick = std::env::var("BRDF_BENCH_QUICK").is_ok_and(|v| v != "0");
     let mut summary = Vec::new();
     let mut versus_pytorch = Vec::new();
-    for (backend, precision) in backends_and_precisions() {
+    for (backend, precision, split) in backends_and_precisions(n) {
         let label = format!("train_step_{backend:?}_{}", precision.name()).to_lowercase();
+        let label = if split > 1 { format!("{label}_split{split}") } else { label };
         let mut group = cr.benchmark_group(label);
         group.sample_size(10).measurement_time(Duration::from_secs(20));
         for (name, c) in configs() {
-            let mut step = Step::new(&c, backend, precision, n);
+            let mut step = Step::new(&c, backend, (precision, split), n);
             step.run();
             if !quick {
                 group.bench_function(name, |b| b.iter(|| step.run()));
             }
             // A direct timing for the summary (criterion's estimate is in its report).
             let secs = median_step(&mut step, 7);
-            summary.push((backend, precision, name, secs, step_flops(&c, n) / secs / 1e9));
+            let gflops = step_flops(&c, n) / secs / 1e9;
+            summary.push((backend, precision, split, name, secs, gflops));
             if name == "single_mlp"
+                && split == default_split(backend, n)
                 && let Ok(python) = std::env::var("BRDF_BENCH_PYTORCH")
             {
                 // Back to back, three rounds: ours then PyTorch's, medians of 10 steps each.
@@ -332,7 +350,9 @@ fn bench(cr: &mut Criterion) {
                     median_step(&mut step, 3);
                     let ours = median_step(&mut step, 10);
                     match pytorch_step(&python, backend, n, 10, bf16) {
-                        Ok(theirs) => versus_pytorch.push((backend, precision, ours, theirs)),
+                        Ok(theirs) => {
+                            versus_pytorch.push((backend, precision, split, ours, theirs))
+                        }
                         Err(e) => {
                             eprintln!("PyTorch baseline not run: {e}");
                             break;
@@ -342,6 +362,9 @@ fn bench(cr: &mut Criterion) {
             }
         }
         group.finish();
+    }
+    for backend in backends().into_iter().filter(|b| b.is_gpu()) {
+        layer_products(backend, n);
     }
     let rates = machine_gemm_rates(n);
     let square = rates.square;
@@ -377,12 +400,13 @@ fn bench(cr: &mut Criterion) {
         );
     }
     println!(
-        "| backend | precision | model | step ms | samples/s | GFLOP/s | fraction of 2048^3 gemm |"
+        "| backend | precision | split | model | step ms | samples/s | GFLOP/s | fraction of the \
+         CPU's 2048^3 gemm |"
     );
-    println!("| --- | --- | --- | ---: | ---: | ---: | ---: |");
-    for (b, p, name, secs, gf) in summary {
+    println!("| --- | --- | ---: | --- | ---: | ---: | ---: | ---: |");
+    for (b, p, split, name, secs, gf) in summary {
         println!(
-            "| {b:?} | {} | {name} | {:.1} | {:.0} | {gf:.1} | {:.2} |",
+            "| {b:?} | {} | {split} | {name} | {:.1} | {:.0} | {gf:.1} | {:.2} |",
             p.name(),
             secs * 1e3,
             n as f64 / secs,
@@ -392,11 +416,12 @@ fn bench(cr: &mut Criterion) {
     if !versus_pytorch.is_empty() {
         println!("\nSingle MLP step, back to back with PyTorch (medians of 10 steps; bf16 against");
         println!("PyTorch's bf16 autocast):");
-        println!("| backend | precision | ours ms | PyTorch ms | ours / PyTorch |");
-        println!("| --- | --- | ---: | ---: | ---: |");
-        for (b, p, ours, theirs) in versus_pytorch {
+        println!("| backend | precision | split | ours ms | PyTorch ms | ours / PyTorch |");
+        println!("| --- | --- | ---: | ---: | ---: | ---: |");
+        for (b, p, split, ours, theirs) in versus_pytorch {
             let (o, t) = (ours * 1e3, theirs * 1e3);
-            println!("| {b:?} | {} | {o:.1} | {t:.1} | {:.3} |", p.name(), ours / theirs);
+            let ratio = ours / theirs;
+            println!("| {b:?} | {} | {split} | {o:.1} | {t:.1} | {ratio:.3} |", p.name());
         }
     }
 }
@@ -412,17 +437,74 @@ fn precisions() -> Vec<MatmulPrecision> {
         .collect()
 }
 
-/// Every backend with every precision it implements (bf16: flex only).
-fn backends_and_precisions() -> Vec<(Backend, MatmulPrecision)> {
+/// Every backend with every precision it implements (bf16: flex only) and every split.
+fn backends_and_precisions(n: usize) -> Vec<(Backend, MatmulPrecision, usize)> {
     let mut out = Vec::new();
     for b in backends() {
         for p in precisions() {
             if p == MatmulPrecision::F32 || b == Backend::Flex {
-                out.push((b, p));
+                out.extend(splits(b, n).into_iter().map(|s| (b, p, s)));
             }
         }
     }
     out
+}
+
+/// The batch splits to time on `backend` (`BRDF_BENCH_SPLIT`, else the trainer's).
+fn splits(backend: Backend, n: usize) -> Vec<usize> {
+    match std::env::var("BRDF_BENCH_SPLIT") {
+        Ok(s) => {
+            s.split(',').map(|p| p.trim().parse().expect("BRDF_BENCH_SPLIT: a number")).collect()
+        }
+        Err(_) => vec![default_split(backend, n)],
+    }
+}
+
+/// The split the trainer uses on `backend` for a batch of `n`.
+fn default_split(backend: Backend, n: usize) -> usize {
+    if backend.is_gpu() { batch_split::gpu_parts(n) } else { 1 }
+}
+
+/// Prints the times of one 128-wide layer's products at batch `n` on `backend` (a GPU):
+/// forward X W, input gradient dY Wᵀ, weight gradient Xᵀ dY plain and split over the batch
+/// into parts (batched products, then the sum over the parts); medians of 11 after 3 warm-up
+/// runs (autotune), each run waited for.
+fn layer_products(backend: Backend, n: usize) {
+    let device = backend.device().expect("backend built");
+    let x: Tensor<2> = Tensor::random([n, 128], Distribution::Uniform(-1.0, 1.0), &device);
+    let dy: Tensor<2> = Tensor::random([n, 128], Distribution::Uniform(-1.0, 1.0), &device);
+    let w: Tensor<2> = Tensor::random([128, 128], Distribution::Uniform(-1.0, 1.0), &device);
+    let time = |f: &dyn Fn() -> Tensor<2>| {
+        let mut times: Vec<f64> = (0..14)
+            .map(|_| {
+                let t = Instant::now();
+                let out = f();
+                device.sync().expect("sync");
+                std::hint::black_box(out);
+                t.elapsed().as_secs_f64()
+            })
+            .skip(3)
+            .collect();
+        times.sort_by(f64::total_cmp);
+        times[times.len() / 2]
+    };
+    let flops = 2.0 * (n * 128 * 128) as f64;
+    let mut rows = vec![
+        ("forward X W".to_string(), time(&|| x.clone().matmul(w.clone()))),
+        ("input gradient dY W^T".into(), time(&|| dy.clone().matmul(w.clone().transpose()))),
+        ("weight gradient X^T dY".into(), time(&|| x.clone().transpose().matmul(dy.clone()))),
+    ];
+    for parts in [16, 64, 256].into_iter().filter(|p| n % p == 0) {
+        let split = |t: &Tensor<2>| t.clone().reshape([parts, n / parts, 128]);
+        let f = || split(&x).swap_dims(1, 2).matmul(split(&dy)).sum_dim(0).reshape([128, 128]);
+        rows.push((format!("weight gradient, {parts} parts"), time(&f)));
+    }
+    println!("\n{backend:?}: one layer's products at batch {n}, 128 x 128 (medians of 11)");
+    println!("| product | ms | GFLOP/s |");
+    println!("| --- | ---: | ---: |");
+    for (name, secs) in rows {
+        println!("| {name} | {:.3} | {:.0} |", secs * 1e3, flops / secs / 1e9);
+    }
 }
 
 /// GFLOP/s (f32, bf16) of flex's products through burn tensors, best of 11: the forward

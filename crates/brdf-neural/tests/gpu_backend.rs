@@ -11,7 +11,9 @@
 //! `BRDF_GPU_BACKEND=cuda` (with `--features cuda`) runs the same tests on CUDA. Every model
 //! kind is initialised on the CPU, copied to the GPU and evaluated there: the BRDF values and the
 //! gradients of a loss must match the CPU's to 1e-4 (relative). A Single MLP trained for 30
-//! Adam steps on both backends from the same start must follow the same loss curve to 1e-3.
+//! Adam steps on both backends from the same start must follow the same loss curve to 1e-3, on
+//! the GPU also with its linear layers' batch split into parts as the trainer does there
+//! ([`brdf_neural::batch_split`]).
 #![cfg(any(feature = "wgpu", feature = "cuda"))]
 
 mod common;
@@ -84,30 +86,58 @@ fn every_model_kind_gives_the_cpus_values_and_gradients_on_the_gpu() {
     }
 }
 
-#[test]
-fn a_single_mlp_trains_along_the_same_loss_curve_on_the_gpu() {
-    let c = small(ModelKind::SingleMlp);
-    let mut r = rng(7);
-    let data: Vec<_> = (0..4)
+/// Four batches of 512 samples with a smooth target of the light direction.
+fn curve_data(c: &ModelConfig, seed: u64) -> Vec<(OwnedSamples, Vec<f32>)> {
+    let mut r = rng(seed);
+    (0..4)
         .map(|_| {
             let s = samples(&mut r, 512, c.spatial_dim);
             let t: Vec<f32> =
                 s.l.iter().flat_map(|l| [0.3 * l[2], 0.2, 0.1 + 0.5 * l[0]]).collect();
             (s, t)
         })
-        .collect();
+        .collect()
+}
+
+/// The loss curves of 30 Adam steps on `data` on the CPU and on the GPU from the same start
+/// (initial weights of seed `init`), the GPU's with its linear layers' batch split into
+/// `parts`; and the model trained on the GPU.
+fn loss_curves(
+    c: &ModelConfig,
+    data: &[(OwnedSamples, Vec<f32>)],
+    init: u64,
+    parts: usize,
+) -> (Vec<f32>, Vec<f32>, BrdfModel) {
     let cpu = brdf_neural::device::cpu_training();
     let gpu_device = gpu().training_device().unwrap();
-    let model = c.init_seeded(&cpu, 5, None).unwrap();
+    let model = c.init_seeded(&cpu, init, None).unwrap();
     let on_gpu = model.clone().fork(&gpu_device);
-    let (_, l_cpu) = train(model, &c, &data, 30, 3e-3, &cpu);
-    let (trained, l_gpu) = train(on_gpu, &c, &data, 30, 3e-3, &gpu_device);
+    let (_, l_cpu) = train(model, c, data, 30, 3e-3, &cpu);
+    let _split = brdf_neural::batch_split::scope(parts);
+    let (trained, l_gpu) = train(on_gpu, c, data, 30, 3e-3, &gpu_device);
     assert!(l_cpu[29] < 0.5 * l_cpu[0], "the CPU fit learns: {l_cpu:?}");
+    (l_cpu, l_gpu, trained)
+}
+
+#[test]
+fn a_single_mlp_trains_along_the_same_loss_curve_on_the_gpu() {
+    let c = small(ModelKind::SingleMlp);
+    let data = curve_data(&c, 7);
+    let (l_cpu, l_gpu, trained) = loss_curves(&c, &data, 5, 1);
     assert_close(&l_gpu, &l_cpu, 1e-3, "loss curve");
     // The trained GPU model comes back to the CPU intact.
+    let cpu = brdf_neural::device::cpu_training();
     let back = trained.fork(&cpu);
     let f = values(back.forward(&c.batch(&data[0].0.view(), None, &cpu).unwrap()).f);
     assert!(f.iter().all(|v| v.is_finite()));
+}
+
+#[test]
+fn the_batch_split_trains_along_the_same_loss_curve_on_the_gpu() {
+    let c = small(ModelKind::SingleMlp);
+    // Two parts of 256 rows each: the split path (batch_split::MIN_ROWS).
+    let (l_cpu, l_gpu, _) = loss_curves(&c, &curve_data(&c, 9), 6, 2);
+    assert_close(&l_gpu, &l_cpu, 1e-3, "loss curve with the batch split");
 }
 
 #[test]
