@@ -1,34 +1,47 @@
 #!/usr/bin/env bash
-# The GPU measurements of the throughput issue in one lease of a lent GPU machine (no Rust
-# toolchain, no network there): binaries built here with `--features wgpu` travel compressed in
+# The GPU measurements of the throughput issue on a lent GPU machine (no Rust toolchain, no
+# network there): binaries built here with `--features wgpu` travel compressed in
 # `.devrun/bin.tar.xz`, the Vulkan loader's Debian packages in `.gl/` (see the device tool's
 # README). Scenes are generated there (the default profile's, and benches/profiles/
 # paper_one_scene.toml at 512 px): both need no data files. Prepare with
-# `benches/device_gpu_prepare.sh`, then run from the checkout's root on the device machine:
+# `benches/device_gpu_prepare.sh`, then run from the checkout's root on the device machine, one
+# stage a call of the device tool (the 15 minutes a session is lent hold the first two):
 #
-#   bash benches/device_gpu.sh            # logs packed into $OUT/logs.tar.gz
+#   bash benches/device_gpu.sh step      # logs packed into $OUT/step.tar.gz
+#   bash benches/device_gpu.sh final     # logs packed into $OUT/final.tar.gz
+#   bash benches/device_gpu.sh e2e       # logs packed into $OUT/e2e.tar.gz (a third lease)
 #
-# Steps, each under its own time limit so that one hang cannot eat the lease:
+# With autotune on (the wgpu feature), the first use of every matrix-product shape in a process
+# is benchmarked, and the first process on a fresh machine also compiles every kernel and runs
+# CubeCL's throughput probes: allow about 10 s a model kind for that.
+#
+# `step`:
 #   1. the device: nvidia-smi, the Vulkan ICD, PyTorch's view of the GPU;
 #   2. correctness: the wgpu path against the CPU (tests/gpu_backend.rs) on the real GPU;
-#   3. the training step at batch 32,768, all 9 model kinds on wgpu, the Single MLP back to back
-#      with PyTorch on CUDA (f32, three rounds), then PyTorch with TF32 and bf16 autocast once;
-#   4. the same bench on the machine's CPU cores (flex) against PyTorch on the CPU;
-#   5. end to end: profile_steps (every model of the default run's Spot x blue-acrylic, fixed
+#   3. the baseline: the previous build's training step (`.devrun_old/bin.tar.xz`, when
+#      carried: burn's wgpu without autotune, fusion or the batch split), same machine;
+#   4. the training step at batch 32,768, three model kinds on wgpu, without and with the batch
+#      split (`brdf_neural::batch_split`), one layer's products alone, and the Single MLP back to
+#      back with PyTorch on CUDA (f32, three rounds);
+#   5. where a step's GPU time goes: CubeCL's kernel profile of Single MLP steps, summed by kernel;
+#   6. the step on the machine's CPU cores (flex), without and with the batch split.
+# `final`: the correctness test with minimal autotune, all 9 kinds' steps at the trainer's
+# split against PyTorch, and three models end to end on the default run's scene.
+# `e2e`:
+#   7. end to end: profile_steps (every model of the default run's Spot x blue-acrylic, fixed
 #      steps, then evaluation) on wgpu;
-#   6. the paper's scale: the same for one scene of the `full` profile (512 px, batch 2^15),
-#      three models (their evaluation at 512 px is the part the bench cannot give);
-#   7. the CPU baselines of 3 and 5 on the machine's cores.
+#   8. the paper's scale: the same for one scene of the `full` profile (512 px, batch 2^15).
 set -u
+STAGE=${1:-step}
 R=.devrun
 OUT=${OUT:-/tmp/device-gpu}
-LOGS=/tmp/device-gpu-logs
+LOGS=/tmp/device-gpu-logs/$STAGE
 mkdir -p "$OUT" "$LOGS"
 STEPS=${DEVICE_STEPS:-300}
 # Every step ends by this many seconds after the start (the device tool's calls are limited).
-DEADLINE=${DEVICE_DEADLINE:-560}
+DEADLINE=${DEVICE_DEADLINE:-400}
 step() { echo; echo "== $(date +%T) $*"; }
-run() { # run LIMIT LOG COMMAND...: time-limited, output to the terminal and $OUT/LOG
+run() { # run LIMIT LOG COMMAND...: time-limited, output to the terminal and $LOGS/LOG
     local limit=$1 log=$2
     shift 2
     local left=$((DEADLINE - SECONDS))
@@ -49,37 +62,76 @@ icd=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 [ -f "$icd" ] && export VK_DRIVER_FILES=$icd
 nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.sm,clocks.max.sm --format=csv
 nproc
-python3 -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name(0))"
-tar -xJf $R/bin.tar.xz -C $R
+[ -d $R/bin ] || tar -xJf $R/bin.tar.xz -C $R
 B=$R/bin
 ls -la $B
 
-step "wgpu against the CPU on this GPU"
-run 60 gpu_backend.log $B/gpu_backend --test-threads=1
+if [ "$STAGE" = step ]; then
+    python3 -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name(0))"
+    step "wgpu against the CPU on this GPU"
+    run 120 gpu_backend.log $B/gpu_backend --test-threads=1
 
-step "training step, wgpu, against PyTorch on CUDA"
-run 200 step_wgpu.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_ALL_MODELS=1 BRDF_BENCH_BACKENDS=wgpu \
-    BRDF_BENCH_PYTORCH=python3 $B/train_step --bench
-for mode in f32 tf32 bf16; do
-    flag=$([ $mode = f32 ] || echo --$mode)
-    run 40 "pytorch_cuda_$mode.log" python3 benches/pytorch_step.py --device cuda $flag
-done
+    if [ -f .devrun_old/bin.tar.xz ]; then
+        step "baseline: the previous build's step on wgpu"
+        mkdir -p /tmp/old && tar -xJf .devrun_old/bin.tar.xz -C /tmp/old
+        run 60 step_wgpu_old.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_BACKENDS=wgpu \
+            /tmp/old/bin/train_step --bench
+    fi
 
-step "the default run's scenes (no training)"
-run 120 default_scenes.log $B/profile_steps --prepare default /tmp/default
-step "end to end on wgpu: $STEPS steps per model, then evaluation"
-run 200 profile_wgpu.log $B/profile_steps /tmp/default spot__blue-acrylic "$STEPS" wgpu
+    step "training step, wgpu: batch split 1 and 64, against PyTorch on CUDA"
+    run 150 step_wgpu.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_BACKENDS=wgpu \
+        BRDF_BENCH_SPLIT=1,64 BRDF_BENCH_PYTORCH=python3 $B/train_step --bench
 
-step "the paper's scale: one scene of the full profile at 512 px"
-run 120 full_scene.log $B/profile_steps --prepare benches/profiles/paper_one_scene.toml /tmp/full
-run 240 profile_full_wgpu.log $B/profile_steps /tmp/full spot__blue-acrylic "${FULL_STEPS:-50}" wgpu \
-    "${FULL_MODELS:-SingleMlp,AdditiveSharedEnhanced,Disney}"
+    step "kernel profile of the Single MLP step (split 64)"
+    printf '[profiling.logger]\nlevel = "basic"\nfile = "/tmp/cubecl_profile.log"\n' >cubecl.toml
+    run 60 step_profiled.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_BACKENDS=wgpu BRDF_BENCH_SPLIT=64 \
+        $B/train_step --bench
+    rm -f cubecl.toml
+    python3 - /tmp/cubecl_profile.log <<'EOF' | tee "$LOGS/kernel_profile.txt"
+import re, sys, collections
+unit = {"ns": 1e-6, "µs": 1e-3, "us": 1e-3, "ms": 1.0, "s": 1e3}
+total, count = collections.Counter(), collections.Counter()
+for line in open(sys.argv[1], errors="replace"):
+    m = re.match(r"\|\s*([0-9.]+)(ns|µs|us|ms|s)\s*\|\s*(.*)", line)
+    if m:
+        name = re.sub(r"<.*", "", m.group(3).strip())[:90]
+        total[name] += float(m.group(1)) * unit[m.group(2)]
+        count[name] += 1
+grand = sum(total.values())
+print(f"{sum(count.values())} launches, {grand:.1f} ms of kernel time in all")
+for name, ms in total.most_common(40):
+    print(f"{ms:9.2f} ms {100 * ms / grand:5.1f} % {count[name]:7d} x  {name}")
+EOF
 
-step "training step, CPU ($(nproc) threads), against PyTorch on the CPU"
-run 120 step_cpu.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_ALL_MODELS=1 BRDF_BENCH_BACKENDS=flex \
-    BRDF_BENCH_PYTORCH=python3 $B/train_step --bench
+    step "training step on the machine's CPU cores (flex): batch split 1 and 16"
+    run 90 step_cpu.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_BACKENDS=flex BRDF_BENCH_SPLIT=1,16 \
+        $B/train_step --bench
+fi
 
-step "end to end on the CPU: $STEPS steps per model, then evaluation"
-run 150 profile_cpu.log $B/profile_steps /tmp/default spot__blue-acrylic "$STEPS" cpu
+if [ "$STAGE" = final ]; then
+    # What a second, shorter call measures after `step` (autotune makes the first use of every
+    # shape slow: the all-model bench with two splits outlasted its limit there).
+    step "wgpu against the CPU on this GPU (autotune minimal)"
+    run 90 gpu_backend.log env CUBECL_AUTOTUNE_LEVEL=minimal $B/gpu_backend --test-threads=1
+    step "training step, wgpu, the trainer's split (64 parts), all 9 kinds, against PyTorch"
+    run 170 step_wgpu.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_ALL_MODELS=1 BRDF_BENCH_BACKENDS=wgpu \
+        BRDF_BENCH_PYTORCH=python3 $B/train_step --bench
+    step "end to end on wgpu: $STEPS steps, three models, then evaluation"
+    run 50 default_scenes.log $B/profile_steps --prepare default /tmp/default
+    run 130 profile_wgpu.log $B/profile_steps /tmp/default spot__blue-acrylic "$STEPS" wgpu \
+        "${E2E_MODELS:-SingleMlp,AdditiveSharedEnhanced,Disney}"
+fi
+
+if [ "$STAGE" = e2e ]; then
+    step "the default run's scenes (no training)"
+    run 120 default_scenes.log $B/profile_steps --prepare default /tmp/default
+    step "end to end on wgpu: $STEPS steps per model, then evaluation"
+    run 200 profile_wgpu.log $B/profile_steps /tmp/default spot__blue-acrylic "$STEPS" wgpu
+
+    step "the paper's scale: one scene of the full profile at 512 px"
+    run 100 full_scene.log $B/profile_steps --prepare benches/profiles/paper_one_scene.toml /tmp/full
+    run 200 profile_full_wgpu.log $B/profile_steps /tmp/full spot__blue-acrylic \
+        "${FULL_STEPS:-50}" wgpu "${FULL_MODELS:-SingleMlp,AdditiveSharedEnhanced,Disney}"
+fi
 step "done"
-tar -czf "$OUT/logs.tar.gz" -C "$LOGS" .
+tar -czf "$OUT/$STAGE.tar.gz" -C "$LOGS" .

@@ -15,11 +15,11 @@ if [ ! -d .gl ]; then
     (cd .gl && apt-get $o download libvulkan1 libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2)
 fi
 
-# The bench and the test build with one feature set (their dev-dependencies join it); the
-# example also makes the scenes there (`--prepare`), so no xtask travels.
-cargo build --release -p experiments --features wgpu --example profile_steps
-cargo bench -p experiments -p brdf-neural --features experiments/wgpu --bench train_step --no-run
-cargo test --release -p experiments -p brdf-neural --features experiments/wgpu --test gpu_backend --no-run
+# The example, the bench and the test in one build, one feature set (their dev-dependencies
+# join it; the bench profile is the release profile); the example also makes the scenes there
+# (`--prepare`), so no xtask travels.
+cargo build --release -p experiments -p brdf-neural --features experiments/wgpu \
+    --example profile_steps --bench train_step --test gpu_backend
 
 newest() { find target/release/deps -maxdepth 1 -type f -executable -name "$1-*" -printf '%T@ %p\n' | sort -n | tail -1 | cut -d' ' -f2; }
 rm -rf $R && mkdir -p $R/bin
