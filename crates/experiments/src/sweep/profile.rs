@@ -342,6 +342,17 @@ mod tests {
     }
 
     #[test]
+    fn the_benches_one_scene_profile_parses_with_its_eval_table() {
+        let path =
+            concat!(env!("CARGO_MANIFEST_DIR"), "/../../benches/profiles/paper_one_scene.toml");
+        let p = SweepProfile::load(path).unwrap();
+        assert_eq!(p.scene_count(), 1);
+        assert_eq!(p.models().unwrap().len(), 9);
+        let config = crate::RunConfig::from_toml(&p.run, Path::new(path)).unwrap();
+        assert_eq!(config.eval.energy_estimator, Some(crate::eval::EnergyEstimator::Fast));
+    }
+
+    #[test]
     fn bad_keys_are_named() {
         let text = BUILT_IN[0].1.replace("[sweep]", "[sweep]\nmodles = []");
         let e = SweepProfile::parse(&text, "x.toml").unwrap_err().to_string();
