@@ -8,6 +8,9 @@
 //! cargo test -p brdf-neural --features wgpu --test gpu_backend
 //! ```
 //!
+//! With burn's autotune on (the GPU features), the first use of each problem shape benchmarks
+//! the candidate kernels: on lavapipe (2 cores) the whole file took 744 s the first time.
+//!
 //! `BRDF_GPU_BACKEND=cuda` (with `--features cuda`) runs the same tests on CUDA. Every model
 //! kind is initialised on the CPU, copied to the GPU and evaluated there: the BRDF values and the
 //! gradients of a loss must match the CPU's to 1e-4 (relative). A Single MLP trained for 30
