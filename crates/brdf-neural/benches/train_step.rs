@@ -494,7 +494,7 @@ fn layer_products(backend: Backend, n: usize) {
         ("input gradient dY W^T".into(), time(&|| dy.clone().matmul(w.clone().transpose()))),
         ("weight gradient X^T dY".into(), time(&|| x.clone().transpose().matmul(dy.clone()))),
     ];
-    for parts in [16, 64, 256].into_iter().filter(|p| n % p == 0) {
+    for parts in [16, 64, 256].into_iter().filter(|p| n.is_multiple_of(*p)) {
         let split = |t: &Tensor<2>| t.clone().reshape([parts, n / parts, 128]);
         let f = || split(&x).swap_dims(1, 2).matmul(split(&dy)).sum_dim(0).reshape([128, 128]);
         rows.push((format!("weight gradient, {parts} parts"), time(&f)));

@@ -44,7 +44,7 @@ pub fn parts() -> usize {
 /// 2^15), at most 64 parts, and 1 where that does not divide the batch.
 pub fn gpu_parts(rows: usize) -> usize {
     let parts = (rows / 512).clamp(1, 64);
-    if rows % parts == 0 { parts } else { 1 }
+    if rows.is_multiple_of(parts) { parts } else { 1 }
 }
 
 /// Restores the thread's previous split when dropped.
@@ -64,7 +64,7 @@ impl Drop for BatchSplitGuard {
 pub(crate) fn linear(layer: &Linear, x: Tensor<2>) -> Tensor<2> {
     let parts = parts();
     let [rows, d_in] = x.dims();
-    if parts <= 1 || rows % parts != 0 || rows / parts < MIN_ROWS {
+    if parts <= 1 || !rows.is_multiple_of(parts) || rows / parts < MIN_ROWS {
         return layer.forward(x);
     }
     let weight = layer.weight.val();

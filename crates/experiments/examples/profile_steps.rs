@@ -19,6 +19,11 @@
 //!
 //! Run it on a quiet machine (no compile: `pgrep -a rustc`). The runs are the sweep's own
 //! configurations with `iterations` set to the step count and snapshots off.
+//!
+//! On a GPU backend each model first trains `PROFILE_WARMUP_STEPS` steps (default 50; 0 on the
+//! CPU) in a run of its own, timed apart: burn's autotune benchmarks kernels at the first use of
+//! each problem shape in a process, and that start-up would otherwise be spread over the
+//! measured steps. The warm-up table gives what it cost.
 
 use experiments::eval::eval_fitted;
 use experiments::eval::fitted::FittedRun;
@@ -69,6 +74,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         return Err(format!("no default runs of {scene} under {}", layout.runs().display()).into());
     }
     let tmp = std::env::temp_dir().join(format!("profile-steps-{}", std::process::id()));
+    let warmup: u64 = match std::env::var("PROFILE_WARMUP_STEPS") {
+        Ok(v) => v.parse()?,
+        Err(_) if backend.is_gpu() => 50,
+        Err(_) => 0,
+    };
     println!(
         "{steps} steps per model on {scene}, backend {backend}; ms per step, then evaluation \
          seconds\n"
@@ -79,6 +89,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     println!("| --- |{}", " ---: |".repeat(10));
     let mut evals = Vec::new();
+    let mut warmups = Vec::new();
     for template in &runs {
         let mut config = RunDir::new(template).read_config()?;
         config.train.iterations = steps;
@@ -88,13 +99,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             continue;
         }
         let run = tmp.join(&kind);
-        let options = FitOptions {
+        let options = || FitOptions {
             progress: false,
             cache_dir: Some(layout.cache()),
             backend,
             ..Default::default()
         };
-        let (outcome, trained) = fit_and_keep(&config, &run, options)?;
+        if warmup > 0 {
+            let mut short = config.clone();
+            short.train.iterations = warmup;
+            let start = Instant::now();
+            fit_and_keep(&short, &tmp.join(format!("{kind}-warmup")), options())?;
+            warmups.push((kind.clone(), start.elapsed().as_secs_f64()));
+        }
+        let (outcome, trained) = fit_and_keep(&config, &run, options())?;
         let trained = trained.ok_or_else(|| format!("{kind}: did not train ({outcome:?})"))?;
         let metrics = experiments::run_dir::RunMetrics::read(&RunDir::new(&run).metrics())?;
         let phases = metrics.phases.unwrap_or_default();
@@ -120,6 +138,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let cells: Vec<String> =
             test.phases.named().iter().map(|(_, s)| format!("{s:.2}")).collect();
         println!("| {kind} | {} | {:.2} |", cells.join(" | "), test.seconds);
+    }
+    if !warmups.is_empty() {
+        println!("\n| model | warm-up: {warmup} steps, wall s (kernel tuning and compilation) |");
+        println!("| --- | ---: |");
+        for (kind, secs) in &warmups {
+            println!("| {kind} | {secs:.2} |");
+        }
     }
     std::fs::remove_dir_all(&tmp).ok();
     Ok(())
