@@ -1,10 +1,12 @@
-//! The CPU backend as this workspace builds it: flex with the patch in `vendor/burn-flex`
-//! (matrix-product outputs allocated aligned instead of copied) and the host-memory policy.
+//! The CPU backend as this workspace builds it: flex with the patches in `vendor/burn-flex`
+//! and the host-memory policy.
 //!
 //! Matrix products and their gradients are compared with f64 references for output sizes on
-//! both sides of the patch (byte sizes that are and are not multiples of 16), for plain and
-//! transposed (strided) operands, and across repeated allocate-and-free cycles as a training
-//! step makes them.
+//! both sides of the alignment patch (byte sizes that are and are not multiples of 16), for
+//! plain and transposed (strided) operands, and across repeated allocate-and-free cycles as a
+//! training step makes them. Products split over k (patch 4) and element-wise ops spread over
+//! the threads (patch 5) are checked against f64 and scalar references and for giving the same
+//! bits on 1, 2 and 3 threads.
 
 use brdf_neural::device;
 use burn::tensor::{Tensor, TensorData};
@@ -90,4 +92,69 @@ fn host_memory_policy_is_active_after_making_a_cpu_device() {
     let off = std::env::var(brdf_neural::host_memory::ENV_OFF).is_ok_and(|v| v.trim() == "0");
     let glibc = cfg!(all(target_os = "linux", target_env = "gnu"));
     assert_eq!(brdf_neural::host_memory::is_active(), glibc && !off);
+}
+
+/// `f` run on a rayon pool of `threads` threads (flex's products and element-wise ops use the
+/// pool they are called from).
+fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(f)
+}
+
+#[test]
+fn long_products_split_over_k_match_f64_and_not_the_thread_count() {
+    // A weight gradient's shape, Xᵀ dY summed over a batch of k rows: vendor/burn-flex patch
+    // 4 sums k in blocks (2 at 9,000, 4 at 16,411), on both sides of the block threshold.
+    let d = device::cpu();
+    for (k, m, n) in [(8_191, 5, 16), (9_000, 7, 19), (16_411, 33, 128)] {
+        let x = values(k * m, k as u64);
+        let dy = values(k * n, 3 * k as u64);
+        let xt: Vec<f32> = (0..m * k).map(|i| x[(i % k) * m + i / k]).collect();
+        let want = reference(&xt, &dy, m, k, n);
+        let product = || {
+            let tx = Tensor::<2>::from_data(TensorData::new(x.clone(), [k, m]), &d);
+            let tdy = Tensor::<2>::from_data(TensorData::new(dy.clone(), [k, n]), &d);
+            tx.transpose().matmul(tdy).into_data().try_to_vec::<f32>().unwrap()
+        };
+        let one = on_threads(1, product);
+        assert_close(&one, &want, &format!("[{k}, {m}]ᵀ x [{k}, {n}]"));
+        for threads in [2, 3] {
+            assert_eq!(on_threads(threads, product), one, "k = {k}, {threads} threads");
+        }
+    }
+}
+
+#[test]
+fn element_wise_ops_on_every_thread_equal_the_scalar_ops() {
+    // Large enough for vendor/burn-flex patch 5 (2^17 elements and more): ReLU and its
+    // backward, a bias add broadcast down the rows, and the bias gradient (a sum over rows).
+    let d = device::cpu_training();
+    let (rows, cols) = (9_001, 37);
+    let z = values(rows * cols, 11);
+    let b = values(cols, 12);
+    let g = values(rows * cols, 13);
+    let step = || {
+        let tz = Tensor::<2>::from_data(TensorData::new(z.clone(), [rows, cols]), &d);
+        let tb = Tensor::<1>::from_data(TensorData::new(b.clone(), [cols]), &d).require_grad();
+        let tg = Tensor::<2>::from_data(TensorData::new(g.clone(), [rows, cols]), &d);
+        let y = burn::tensor::activation::relu(tz + tb.clone().unsqueeze::<2>());
+        let grads = (y.clone() * tg).sum().backward();
+        let gb = tb.grad(&grads).unwrap().into_data().try_to_vec::<f32>().unwrap();
+        (y.into_data().try_to_vec::<f32>().unwrap(), gb)
+    };
+    let (y, gb) = on_threads(1, step);
+    for (i, yi) in y.iter().enumerate() {
+        assert_eq!(*yi, (z[i] + b[i % cols]).max(0.0), "relu(z + b)[{i}]");
+    }
+    let want: Vec<f64> = (0..cols)
+        .map(|c| {
+            (0..rows)
+                .filter(|r| z[r * cols + c] + b[c] > 0.0)
+                .map(|r| f64::from(g[r * cols + c]))
+                .sum()
+        })
+        .collect();
+    assert_close(&gb, &want, "bias gradient");
+    for threads in [2, 3] {
+        assert_eq!(on_threads(threads, step), (y.clone(), gb.clone()), "{threads} threads");
+    }
 }

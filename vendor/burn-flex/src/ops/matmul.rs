@@ -102,6 +102,9 @@ pub fn matmul(lhs: FlexTensor, rhs: FlexTensor) -> FlexTensor {
             if let Some(out) = matmul_f32_bf16dot(&lhs, &rhs) {
                 return out;
             }
+            if let Some(out) = matmul_f32_split_k(&lhs, &rhs) {
+                return out;
+            }
             matmul_gemm::<f32>(lhs, rhs)
         }
         DType::F64 => matmul_gemm::<f64>(lhs, rhs),
@@ -140,6 +143,30 @@ fn matmul_f32_bf16dot(lhs: &FlexTensor, rhs: &FlexTensor) -> Option<FlexTensor> 
             crate::ops::matmul_bf16dot::matmul_bf16dot(m, n, k, a, b, out)
         })
     })
+}
+
+/// An f32 product with a long inner dimension and a small output (a weight gradient), summed
+/// in blocks of k in parallel (patch 4, [`crate::ops::matmul_split_k`]); `None` for every
+/// other product.
+fn matmul_f32_split_k(lhs: &FlexTensor, rhs: &FlexTensor) -> Option<FlexTensor> {
+    use crate::ops::matmul_split_k::{Operand, matmul_split_k, split_k_blocks};
+    let (ls, rs) = (lhs.layout().shape(), rhs.layout().shape());
+    if ls.num_dims() != 2 || rs.num_dims() != 2 {
+        return None;
+    }
+    let (m, k, n) = (ls[0], ls[1], rs[1]);
+    let blocks = split_k_blocks(m, n, k);
+    if blocks <= 1 {
+        return None;
+    }
+    let (lrs, lcs) = get_2d_strides(lhs.layout());
+    let (rrs, rcs) = get_2d_strides(rhs.layout());
+    let ldata: &[f32] = lhs.storage();
+    let rdata: &[f32] = rhs.storage();
+    let a = Operand { ptr: unsafe { ldata.as_ptr().add(lhs.layout().start_offset()) }, rs: lrs, cs: lcs };
+    let b = Operand { ptr: unsafe { rdata.as_ptr().add(rhs.layout().start_offset()) }, rs: rrs, cs: rcs };
+    // SAFETY: `matmul_split_k` writes every element of its m x n output.
+    Some(unsafe { output_written_by::<f32>(m, n, |out| matmul_split_k(m, n, k, blocks, a, b, out)) })
 }
 
 /// A contiguous m x n output tensor filled by `write`, allocated without zeroing when its size

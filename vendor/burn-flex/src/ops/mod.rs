@@ -113,6 +113,7 @@ pub mod mask;
 pub mod matmul;
 #[cfg(feature = "std")]
 pub mod matmul_bf16dot;
+pub mod matmul_split_k;
 mod module;
 pub mod pool;
 mod qtensor;
