@@ -158,3 +158,18 @@ fn element_wise_ops_on_every_thread_equal_the_scalar_ops() {
         assert_eq!(on_threads(threads, step), (y.clone(), gb.clone()), "{threads} threads");
     }
 }
+
+#[test]
+fn row_broadcasts_of_empty_and_thin_matrices_add_correctly() {
+    // The bias add of patch 5 takes dense [rows, cols] + [1, cols]; empty and one-wide shapes
+    // must still add (the patch also guards its row loop against an empty row, which upstream's
+    // layout collapse does not let reach it today).
+    let d = device::cpu();
+    for (rows, cols) in [(0, 5), (5, 0), (1, 3), (3, 1)] {
+        let m = Tensor::<2>::zeros([rows, cols], &d);
+        let b = Tensor::<2>::from_data(TensorData::new(values(cols, 5), [1, cols]), &d);
+        let got = (m + b).into_data().try_to_vec::<f32>().unwrap();
+        let want: Vec<f32> = (0..rows).flat_map(|_| values(cols, 5)).collect();
+        assert_eq!(got, want, "[{rows}, {cols}]");
+    }
+}

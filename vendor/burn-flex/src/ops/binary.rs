@@ -180,7 +180,12 @@ where
         let rhs_storage: &[E] = rhs.storage();
         let lhs_storage: &mut [E] = lhs.storage_mut();
         // A row broadcast down a dense matrix (a bias add): on every thread (patch 5).
-        if nest.ndim == 2 && nest.rhs_strides[0] == 0 && nest.rhs_strides[1] == 1 {
+        if nest.ndim == 2
+            && nest.rhs_strides[0] == 0
+            && nest.rhs_strides[1] == 1
+            && nest.shape[0] > 0
+            && nest.shape[1] > 0
+        {
             let (rows, cols) = (nest.shape[0], nest.shape[1]);
             let row = &rhs_storage[nest.rhs_offset..nest.rhs_offset + cols];
             crate::par_elementwise::rows_inplace(&mut lhs_storage[..rows * cols], row, &op);
