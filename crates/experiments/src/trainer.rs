@@ -143,8 +143,7 @@ impl Loop<'_> {
         timer.charge(Phase::Gather);
         let swap = c.angles.reciprocity == Reciprocity::RandomSwap;
         let mask = swap.then(|| c.angles.swap_mask(bs, &mut rng));
-        let samples = Samples { spatial: &cpu.spatial, l: &cpu.l, v: &cpu.v };
-        let batch = c.batch(&samples, mask.as_deref(), &self.device)?;
+        let batch = c.batch_owned(cpu.spatial, &cpu.l, &cpu.v, mask.as_deref(), &self.device)?;
         let weight = tensor(cpu.weight, bs, &self.device);
         let target = tensor(cpu.target_gamma, bs, &self.device);
         timer.charge(Phase::Encode);
@@ -160,6 +159,9 @@ impl Loop<'_> {
         timer.charge(Phase::Loss);
         if !value.is_finite() {
             self.bar.abandon();
+            // The batch again, unsanitised (the batch took its spatial rows): what was fed.
+            let cpu = self.data.gather(&indices);
+            let samples = Samples { spatial: &cpu.spatial, l: &cpu.l, v: &cpu.v };
             let input = worst_input(&out, &samples);
             return Err(Error::NonFinite {
                 step,
