@@ -10,6 +10,7 @@
 #   bash benches/device_gpu.sh step      # logs packed into $OUT/step.tar.gz
 #   bash benches/device_gpu.sh final     # logs packed into $OUT/final.tar.gz
 #   bash benches/device_gpu.sh e2e       # logs packed into $OUT/e2e.tar.gz (a third lease)
+#   bash benches/device_gpu.sh paper     # the full profile's one scene, all 9 models; one lease
 #
 # With autotune on (the wgpu feature), the first use of every matrix-product shape in a process
 # is benchmarked, and the first process on a fresh machine also compiles every kernel and runs
@@ -27,6 +28,9 @@
 #   6. the step on the machine's CPU cores (flex), without and with the batch split.
 # `final`: the correctness test with minimal autotune, all 9 kinds' steps at the trainer's
 # split against PyTorch, and three models end to end on the default run's scene.
+# `paper`: all 9 models on one scene of the `full` profile (512 px, batch 2^15): the real
+# training loop's samples/s after a warm-up, the validation pass, the evaluation at 512 px; then
+# the default run's Single MLP for its converged CPU fit's steps; the GPU's use, sampled.
 # `e2e`:
 #   7. end to end: profile_steps (every model of the default run's Spot x blue-acrylic, fixed
 #      steps, then evaluation) on wgpu;
@@ -120,6 +124,37 @@ if [ "$STAGE" = final ]; then
     run 50 default_scenes.log $B/profile_steps --prepare default /tmp/default
     run 130 profile_wgpu.log $B/profile_steps /tmp/default spot__blue-acrylic "$STEPS" wgpu \
         "${E2E_MODELS:-SingleMlp,AdditiveSharedEnhanced,Disney}"
+fi
+
+if [ "$STAGE" = paper ]; then
+    # One call for the paper's scale (items 4 and 5 of the throughput issue): every model of
+    # Table 1 on one scene of the `full` profile, against the previous build's Single MLP; then
+    # the default run's Single MLP for the steps of its converged CPU fit. `nvidia-smi dmon`
+    # samples the GPU's use every second. Each model's warm-up fit (PROFILE_WARMUP_STEPS) runs
+    # as many steps as the measured one, so that both hold one validation pass (every 250
+    # steps in the `full` profile) and autotune's start-up stays in the warm-up.
+    nvidia-smi dmon -s u -d 1 >"$LOGS/gpu_use.log" 2>&1 &
+    DMON=$!
+    export PROFILE_WARMUP_STEPS=${FULL_STEPS:-250}
+    step "wgpu: batch rows selected on the device against the rows gathered on the CPU"
+    run 45 gpu_backend.log $B/gpu_backend spatial_rows --test-threads=1
+    step "the paper's scale: one scene of the full profile at 512 px (scene, features, runs)"
+    run 150 full_scene.log $B/profile_steps --prepare benches/profiles/paper_one_scene.toml /tmp/full
+    if [ -f .devrun_old/bin.tar.xz ]; then
+        step "baseline: the previous build (batch rows gathered on the CPU), Single MLP"
+        mkdir -p /tmp/old && tar -xJf .devrun_old/bin.tar.xz -C /tmp/old
+        run 100 profile_full_old.log /tmp/old/bin/profile_steps /tmp/full spot__blue-acrylic \
+            "${FULL_STEPS:-250}" wgpu SingleMlp
+    fi
+    step "the full profile on wgpu, all 9 models (evaluated at 512 px: ${FULL_EVAL:-Fmbrdf})"
+    run "${FULL_LIMIT:-330}" profile_full_wgpu.log env PROFILE_EVAL="${FULL_EVAL:-Fmbrdf}" \
+        $B/profile_steps /tmp/full spot__blue-acrylic "${FULL_STEPS:-250}" wgpu ${FULL_MODELS:+"$FULL_MODELS"}
+    step "the default run's scene: the Single MLP for the 1,400 steps of its converged CPU fit"
+    export PROFILE_WARMUP_STEPS=50
+    run 40 default_scenes.log $B/profile_steps --prepare default /tmp/default
+    run 80 profile_wgpu.log $B/profile_steps /tmp/default spot__blue-acrylic \
+        "${DEFAULT_STEPS:-1400}" wgpu SingleMlp
+    kill $DMON
 fi
 
 if [ "$STAGE" = e2e ]; then

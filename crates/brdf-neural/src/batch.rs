@@ -8,10 +8,16 @@
 //! Spatial features are sanitised: NaN becomes 0 and values are clamped into
 //! [-[`SPATIAL_LIMIT`], [`SPATIAL_LIMIT`]] (the LBO features lie in [-1, 1]), so that no input
 //! can make a model's output overflow.
+//!
+//! A training loop on a GPU keeps the feature rows of all its surface points on the device
+//! ([`SpatialTable`], sanitised once) and selects each batch's rows there
+//! ([`ModelConfig::batch_from_table`]): the same values as gathering them on the CPU and
+//! uploading them with every batch ([`ModelConfig::batch_owned`]), without the copy and the
+//! transfer.
 
 use crate::tensor_brdf::Geometry;
 use crate::{Error, ModelConfig, ModelKind, Result};
-use burn::tensor::{Device, Tensor, TensorData};
+use burn::tensor::{Device, Int, Tensor, TensorData};
 
 /// Bound on the magnitude of a spatial feature value.
 pub const SPATIAL_LIMIT: f32 = 1e3;
@@ -38,7 +44,83 @@ pub struct BrdfBatch {
     pub geometry: Option<Geometry>,
 }
 
+/// The spatial feature rows of a set of surface points on the device, sanitised, for
+/// [`ModelConfig::batch_from_table`].
+#[derive(Clone, Debug)]
+pub struct SpatialTable {
+    /// `[points, spatial_dim]`.
+    rows: Tensor<2>,
+    /// Number of rows.
+    points: usize,
+}
+
+impl SpatialTable {
+    /// Number of points (rows).
+    pub fn points(&self) -> usize {
+        self.points
+    }
+}
+
+/// NaN to 0 and every value into [-[`SPATIAL_LIMIT`], [`SPATIAL_LIMIT`]], on every thread.
+fn sanitise(values: &mut [f32]) {
+    use rayon::prelude::*;
+    values
+        .par_iter_mut()
+        .with_min_len(1 << 14)
+        .for_each(|x| *x = if x.is_nan() { 0.0 } else { x.clamp(-SPATIAL_LIMIT, SPATIAL_LIMIT) });
+}
+
 impl ModelConfig {
+    /// Uploads the feature rows of a set of points (row-major `[points, spatial_dim]`),
+    /// sanitised, for [`ModelConfig::batch_from_table`].
+    pub fn spatial_table(&self, rows: &[f32], device: &Device) -> Result<SpatialTable> {
+        let k = self.spatial_dim;
+        if k == 0 || !rows.len().is_multiple_of(k) {
+            return Err(Error::BatchShape(format!(
+                "a spatial table of {} values for spatial_dim {k}",
+                rows.len()
+            )));
+        }
+        let points = rows.len() / k;
+        let mut rows = rows.to_vec();
+        sanitise(&mut rows);
+        let rows = Tensor::from_data(TensorData::new(rows, [points, k]), device);
+        Ok(SpatialTable { rows, points })
+    }
+
+    /// [`ModelConfig::batch`] with the spatial features of sample i the row `points[i]` of
+    /// `table`, selected on the device: the same values as `batch` with those rows gathered on
+    /// the CPU.
+    pub fn batch_from_table(
+        &self,
+        table: &SpatialTable,
+        points: &[u32],
+        l: &[[f32; 3]],
+        v: &[[f32; 3]],
+        swap: Option<&[bool]>,
+        device: &Device,
+    ) -> Result<BrdfBatch> {
+        let n = l.len();
+        let [_, k] = table.rows.dims();
+        if points.len() != n || k != self.spatial_dim {
+            return Err(Error::BatchShape(format!(
+                "{} points for {n} samples, a table of width {k} for spatial_dim {}",
+                points.len(),
+                self.spatial_dim
+            )));
+        }
+        if let Some(&p) = points.iter().find(|&&p| p as usize >= table.points) {
+            return Err(Error::BatchShape(format!(
+                "point {p} outside a spatial table of {} points",
+                table.points
+            )));
+        }
+        let index: Vec<i32> = points.iter().map(|&p| p as i32).collect();
+        let index = Tensor::<1, Int>::from_data(TensorData::new(index, [n]), device);
+        let spatial = table.rows.clone().select(0, index);
+        self.batch_with_spatial(spatial, l, v, swap, device)
+    }
+
     /// Uploads a batch for this model. `swap[i]` swaps l and v in the network input of sample
     /// i (training with [`crate::Reciprocity::RandomSwap`]; see
     /// [`crate::AngleConfig::swap_mask`]); the geometry of parametric models always uses the
@@ -68,16 +150,27 @@ impl ModelConfig {
                 self.spatial_dim
             )));
         }
+        sanitise(&mut spatial);
+        let spatial = Tensor::from_data(TensorData::new(spatial, [n, self.spatial_dim]), device);
+        self.batch_with_spatial(spatial, l, v, swap, device)
+    }
+
+    /// The batch of the spatial rows `spatial` (on the device) and the directions.
+    fn batch_with_spatial(
+        &self,
+        spatial: Tensor<2>,
+        l: &[[f32; 3]],
+        v: &[[f32; 3]],
+        swap: Option<&[bool]>,
+        device: &Device,
+    ) -> Result<BrdfBatch> {
+        let n = l.len();
+        if v.len() != n {
+            return Err(Error::BatchShape(format!("{n} light and {} view directions", v.len())));
+        }
         if swap.is_some_and(|m| m.len() != n) {
             return Err(Error::BatchShape("swap mask length differs from the batch".into()));
         }
-        {
-            use rayon::prelude::*;
-            spatial.par_iter_mut().with_min_len(1 << 14).for_each(|x| {
-                *x = if x.is_nan() { 0.0 } else { x.clamp(-SPATIAL_LIMIT, SPATIAL_LIMIT) }
-            });
-        }
-        let spatial = Tensor::from_data(TensorData::new(spatial, [n, self.spatial_dim]), device);
         let angles = self.uses_angle_features().then(|| {
             let d = self.angles.dim();
             let a = self.angles.encode_batch(l, v, swap);
@@ -138,5 +231,58 @@ mod tests {
         let l = [[0.0, 0.0, 1.0]];
         assert!(config.batch_owned(vec![0.0; 6], &l, &l, None, &device).is_err(), "short rows");
         assert!(config.batch_owned(vec![0.0; 7], &l, &l, Some(&[]), &device).is_err(), "mask");
+    }
+
+    /// Rows selected from a [`SpatialTable`] on the device give the batch that gathering
+    /// the same rows on the CPU gives, bit for bit (the model's output too, so the geometry of
+    /// the parametric models agrees as well); bad points and shapes are errors.
+    #[test]
+    fn table_batches_agree_with_gathered_batches_bitwise() {
+        let device = crate::device::cpu();
+        let (k, points, n) = (5, 40, 300);
+        let special = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 1e30, -0.0];
+        let table: Vec<f32> = (0..points * k)
+            .map(|i| if i % 13 == 0 { special[i / 13 % 5] } else { (i as f32 * 0.71).cos() })
+            .collect();
+        let rows: Vec<u32> = (0..n).map(|i| ((i * 7 + i / 3) % points) as u32).collect();
+        let gathered: Vec<f32> = rows
+            .iter()
+            .flat_map(|&p| table[p as usize * k..(p as usize + 1) * k].to_vec())
+            .collect();
+        let dir = |i: usize, s: f32| {
+            let (a, b) = ((i as f32 * 0.13 + s).sin() * 0.6, (i as f32 * 0.05 - s).cos() * 0.6);
+            [a, b, (1.0 - a * a - b * b).max(0.0).sqrt()]
+        };
+        let l: Vec<[f32; 3]> = (0..n).map(|i| dir(i, 0.2)).collect();
+        let v: Vec<[f32; 3]> = (0..n).map(|i| dir(i, 0.9)).collect();
+        let swap: Vec<bool> = (0..n).map(|i| i % 4 == 1).collect();
+        let bits = |t: Tensor<2>| -> Vec<u32> {
+            t.into_data().try_to_vec::<f32>().unwrap().iter().map(|x| x.to_bits()).collect()
+        };
+        for kind in [ModelKind::SingleMlp, ModelKind::Disney, ModelKind::Fmbrdf] {
+            let config = ModelConfig { kind, spatial_dim: k, ..Default::default() };
+            let t = config.spatial_table(&table, &device).unwrap();
+            assert_eq!(t.points(), points);
+            let a = config.batch_owned(gathered.clone(), &l, &v, Some(&swap), &device).unwrap();
+            let b = config.batch_from_table(&t, &rows, &l, &v, Some(&swap), &device).unwrap();
+            assert_eq!(bits(a.spatial.clone()), bits(b.spatial.clone()), "{kind:?} spatial");
+            if let (Some(x), Some(y)) = (&a.angles, &b.angles) {
+                assert_eq!(bits(x.clone()), bits(y.clone()), "{kind:?} angles");
+            }
+            assert_eq!(a.angles.is_some(), b.angles.is_some());
+            let model = config.init(&device).unwrap();
+            let (fa, fb) = (model.forward(&a), model.forward(&b));
+            assert_eq!(bits(fa.f), bits(fb.f), "{kind:?} output");
+        }
+        let config = ModelConfig { spatial_dim: k, ..Default::default() };
+        let t = config.spatial_table(&table, &device).unwrap();
+        let one = [[0.0, 0.0, 1.0]];
+        let far = [points as u32];
+        assert!(config.batch_from_table(&t, &far, &one, &one, None, &device).is_err(), "point");
+        assert!(config.batch_from_table(&t, &[0, 1], &one, &one, None, &device).is_err(), "len");
+        assert!(config.batch_from_table(&t, &[0], &one, &[], None, &device).is_err(), "views");
+        assert!(config.spatial_table(&table[..k + 1], &device).is_err(), "ragged table");
+        let wide = ModelConfig { spatial_dim: k + 1, ..Default::default() };
+        assert!(wide.batch_from_table(&t, &[0], &one, &one, None, &device).is_err(), "width");
     }
 }

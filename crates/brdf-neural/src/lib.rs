@@ -86,7 +86,7 @@ pub mod precision;
 pub mod single_mlp;
 pub mod tensor_brdf;
 
-pub use batch::{BrdfBatch, SPATIAL_LIMIT, Samples};
+pub use batch::{BrdfBatch, SPATIAL_LIMIT, Samples, SpatialTable};
 pub use error::{Error, Result};
 pub use features::{AngleConfig, AngleParametrization, Reciprocity};
 pub use model::{BrdfModel, ModelConfig, ModelKind};

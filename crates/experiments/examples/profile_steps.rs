@@ -20,6 +20,9 @@
 //! Run it on a quiet machine (no compile: `pgrep -a rustc`). The runs are the sweep's own
 //! configurations with `iterations` set to the step count and snapshots off.
 //!
+//! `PROFILE_EVAL` (a comma-separated list of model kinds, or `none`) evaluates only those
+//! models (default: all); each evaluation's phases are also printed to stderr as it ends.
+//!
 //! On a GPU backend each model first trains `PROFILE_WARMUP_STEPS` steps (default 50; 0 on the
 //! CPU) in a run of its own, timed apart: burn's autotune benchmarks kernels at the first use of
 //! each problem shape in a process, and that start-up would otherwise be spread over the
@@ -61,6 +64,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let steps: u64 = rest.first().map_or(Ok(300), |s| s.parse())?;
     let backend = brdf_neural::device::Backend::parse(rest.get(1).map_or("cpu", String::as_str))?;
     let only: Option<Vec<&str>> = rest.get(2).map(|m| m.split(',').map(str::trim).collect());
+    let eval_list = std::env::var("PROFILE_EVAL").ok();
+    let eval_only: Option<Vec<&str>> =
+        eval_list.as_deref().map(|m| m.split(',').map(str::trim).collect());
     let layout = SweepLayout::new(out);
     let mut runs: Vec<PathBuf> = std::fs::read_dir(layout.runs())?
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -124,10 +130,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             cells.join(" | "),
             metrics.samples_per_second
         );
+        if eval_only.as_ref().is_some_and(|e| !e.contains(&kind.as_str())) {
+            continue;
+        }
         let start = Instant::now();
         let fitted = FittedRun::from_trained(config, trained, layout.cache());
         let test = eval_fitted(&fitted, &run, false, start)?;
-        eprintln!("{kind}: evaluated in {:.2} s", test.seconds);
+        let cells: Vec<String> =
+            test.phases.named().iter().map(|(name, s)| format!("{name} {s:.2}")).collect();
+        eprintln!("{kind}: evaluated in {:.2} s ({})", test.seconds, cells.join(", "));
         evals.push((kind, test));
     }
     println!(

@@ -50,6 +50,9 @@ pub struct TrainingData {
     pub clip: Option<f32>,
 }
 
+/// Records a thread gathers at a time.
+const GATHER_ROWS: usize = 512;
+
 /// A gathered batch on the CPU.
 #[derive(Clone, Debug, Default)]
 pub struct CpuBatch {
@@ -156,19 +159,11 @@ impl TrainingData {
         let (n, k) = (indices.len(), self.spatial_dim);
         // Random reads: chunks of records on every thread, first the spatial rows (most of the
         // bytes), then the per-record fields (the same values on any thread count).
-        const ROWS: usize = 512;
         // Zeroed on every thread too (a single-threaded calloc costs as much as the copy).
         let mut spatial = Vec::with_capacity(n * k);
         spatial.par_extend(rayon::iter::repeat_n(0.0, n * k));
-        let mut b = CpuBatch {
-            spatial,
-            l: vec![[0.0; 3]; n],
-            v: vec![[0.0; 3]; n],
-            weight: vec![0.0; n * 3],
-            target_gamma: vec![0.0; n * 3],
-        };
         if k > 0 {
-            b.spatial.par_chunks_mut(ROWS * k).zip(indices.par_chunks(ROWS)).for_each(
+            spatial.par_chunks_mut(GATHER_ROWS * k).zip(indices.par_chunks(GATHER_ROWS)).for_each(
                 |(dst, idx)| {
                     for (d, &i) in dst.chunks_exact_mut(k).zip(idx) {
                         d.copy_from_slice(self.spatial_row(i));
@@ -176,6 +171,28 @@ impl TrainingData {
                 },
             );
         }
+        CpuBatch { spatial, ..self.gather_fields(indices) }
+    }
+
+    /// The points (rows of [`TrainingData::spatial`]) of the records at `indices`: with
+    /// [`TrainingData::gather_fields`], a batch whose spatial rows are selected elsewhere (on
+    /// the device, from a `brdf_neural::SpatialTable`).
+    pub fn points_of(&self, indices: &[usize]) -> Vec<u32> {
+        indices.iter().map(|&i| self.point[i]).collect()
+    }
+
+    /// [`TrainingData::gather`] without the spatial rows (`spatial` left empty).
+    pub fn gather_fields(&self, indices: &[usize]) -> CpuBatch {
+        use rayon::prelude::*;
+        const ROWS: usize = GATHER_ROWS;
+        let n = indices.len();
+        let mut b = CpuBatch {
+            spatial: Vec::new(),
+            l: vec![[0.0; 3]; n],
+            v: vec![[0.0; 3]; n],
+            weight: vec![0.0; n * 3],
+            target_gamma: vec![0.0; n * 3],
+        };
         (
             b.l.par_chunks_mut(ROWS),
             b.v.par_chunks_mut(ROWS),
@@ -429,6 +446,18 @@ mod tests {
                 assert_eq!(got.weight, want.weight, "weights, {threads} threads");
                 assert_eq!(got.target_gamma, want.target_gamma, "targets, {threads} threads");
             }
+            // The split a device-side selection uses: the fields, and the points whose rows
+            // are the spatial rows.
+            let fields = d.gather_fields(&indices);
+            assert!(fields.spatial.is_empty());
+            assert_eq!((&fields.l, &fields.v, &fields.weight), (&want.l, &want.v, &want.weight));
+            assert_eq!(fields.target_gamma, want.target_gamma);
+            let rows: Vec<f32> = d
+                .points_of(&indices)
+                .iter()
+                .flat_map(|&p| d.spatial[p as usize * k..(p as usize + 1) * k].to_vec())
+                .collect();
+            assert_eq!(rows, want.spatial, "rows of points_of, k = {k}");
         }
     }
 }

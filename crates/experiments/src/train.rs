@@ -19,7 +19,7 @@ use crate::config::RunConfig;
 use crate::data::{TrainingData, spatial_features, split_validation, validation_pairs};
 use crate::run_dir::{RunDir, RunMetrics};
 use crate::train_config::OutputInit;
-use crate::trainer::{Loop, LoopEnd, gamma_mse, save_weights};
+use crate::trainer::{Loop, LoopEnd, device_table, gamma_mse, save_weights};
 use crate::{Error, Result};
 use brdf_neural::precision::MatmulPrecision;
 use brdf_neural::{BrdfModel, batch_split};
@@ -49,6 +49,10 @@ pub struct FitOptions {
     pub config_from_run_dir: bool,
     /// The burn backend that trains (`--backend`; default: the CPU backend).
     pub backend: brdf_neural::device::Backend,
+    /// Whether each batch selects its spatial rows from a table kept on the device
+    /// ([`crate::trainer::device_table`]); `None`: on GPU backends. The same values either
+    /// way (tests compare the two on the CPU).
+    pub spatial_on_device: Option<bool>,
 }
 
 /// How [`fit`] ended.
@@ -219,7 +223,9 @@ pub fn fit_and_keep(
     }
     let resumed_from = state.step;
     let bar = progress_bar(options.progress, t.iterations, state.step);
-    let lp = Loop { config, run: &dir, data: &data, val: &val, device, bar };
+    let on_device = options.spatial_on_device.unwrap_or(options.backend.is_gpu());
+    let spatial = device_table(&config.model, &data, on_device, &device)?;
+    let lp = Loop { config, run: &dir, data: &data, val: &val, device, spatial, bar };
     // The matrix-product precision of this thread's training steps; evaluation keeps f32.
     let precision = t.matmul_precision.scope(options.backend)?;
     if t.matmul_precision == MatmulPrecision::Bf16 && !MatmulPrecision::bf16_native() {

@@ -15,7 +15,7 @@ use crate::plateau::{Decision, StopReason};
 use crate::profile::{Phase, PhaseTimer};
 use crate::run_dir::{CurveRow, RunDir, Snapshot, write_curve};
 use crate::{Error, Result};
-use brdf_neural::{BrdfModel, Reciprocity, Samples};
+use brdf_neural::{BrdfModel, Reciprocity, Samples, SpatialTable};
 use burn::module::Module;
 use burn::optim::{GradientsParams, ModuleOptimizer};
 use burn::tensor::{Device, Tensor, TensorData};
@@ -49,6 +49,9 @@ pub(crate) struct Loop<'a> {
     pub val: &'a TrainingData,
     /// The training (autodiff) device.
     pub device: Device,
+    /// On a GPU: the spatial rows of every point, on the device, where each batch selects its
+    /// rows ([`device_table`]); `None`: batches gather them on the CPU.
+    pub spatial: Option<SpatialTable>,
     /// The progress bar (hidden when not shown).
     pub bar: ProgressBar,
 }
@@ -139,11 +142,21 @@ impl Loop<'_> {
         let mut rng = step_rng(self.config.seed, step);
         let n = self.data.len();
         let indices: Vec<usize> = (0..bs).map(|_| rng.random_range(0..n)).collect();
-        let cpu = self.data.gather(&indices);
+        let cpu = match &self.spatial {
+            Some(_) => self.data.gather_fields(&indices),
+            None => self.data.gather(&indices),
+        };
         timer.charge(Phase::Gather);
         let swap = c.angles.reciprocity == Reciprocity::RandomSwap;
         let mask = swap.then(|| c.angles.swap_mask(bs, &mut rng));
-        let batch = c.batch_owned(cpu.spatial, &cpu.l, &cpu.v, mask.as_deref(), &self.device)?;
+        let (l, v, mask) = (&cpu.l, &cpu.v, mask.as_deref());
+        let batch = match &self.spatial {
+            Some(table) => {
+                let points = self.data.points_of(&indices);
+                c.batch_from_table(table, &points, l, v, mask, &self.device)?
+            }
+            None => c.batch_owned(cpu.spatial, l, v, mask, &self.device)?,
+        };
         let weight = tensor(cpu.weight, bs, &self.device);
         let target = tensor(cpu.target_gamma, bs, &self.device);
         timer.charge(Phase::Encode);
@@ -237,6 +250,27 @@ impl Loop<'_> {
         write_curve(&self.run.curve(), &state.curve)?;
         Ok(dir)
     }
+}
+
+/// Largest spatial table [`device_table`] puts on a GPU, in bytes (a 512 px scene of the
+/// `full` profile has about a gigabyte).
+pub const DEVICE_TABLE_MAX_BYTES: usize = 2 << 30;
+
+/// The spatial rows of every point of `data` on `device` when `on_device` (the trainer's
+/// default on a GPU): each batch then selects its rows there, instead of 640 bytes a sample
+/// copied on the CPU and uploaded with every step. `None` otherwise (on the CPU the gather is
+/// the selection), without spatial features, or past [`DEVICE_TABLE_MAX_BYTES`].
+pub fn device_table(
+    model: &brdf_neural::ModelConfig,
+    data: &TrainingData,
+    on_device: bool,
+    device: &Device,
+) -> Result<Option<SpatialTable>> {
+    let bytes = std::mem::size_of_val(data.spatial.as_slice());
+    if !on_device || data.spatial_dim == 0 || bytes > DEVICE_TABLE_MAX_BYTES {
+        return Ok(None);
+    }
+    Ok(Some(model.spatial_table(&data.spatial, device)?))
 }
 
 /// The gamma-MSE of `model` on the records `val` (no regularisers), computed in inference

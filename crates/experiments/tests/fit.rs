@@ -241,6 +241,23 @@ fn runs_are_deterministic_and_resume_is_exact() {
     assert!(msg.contains("train.iterations"), "{msg}");
 }
 
+/// Batches whose spatial rows are selected from a table on the device (a GPU's default) train
+/// exactly as batches gathered on the CPU: the same losses to the bit, on the CPU backend.
+#[test]
+fn spatial_rows_selected_on_the_device_train_like_gathered_ones() {
+    let dir = TempDir::new("table");
+    for kind in ["single_mlp", "disney"] {
+        let c = config(kind, 30, "validate_every = 10\n");
+        let (a, b) = (dir.0.join(format!("{kind}-host")), dir.0.join(format!("{kind}-table")));
+        fit(&c, &a, FitOptions { spatial_on_device: Some(false), ..Default::default() }).unwrap();
+        fit(&c, &b, FitOptions { spatial_on_device: Some(true), ..Default::default() }).unwrap();
+        assert_eq!(losses(&a).len(), 3, "{kind}");
+        assert_eq!(losses(&a), losses(&b), "{kind}: losses differ");
+        let weights = |run: &Path| std::fs::read(run.join("weights.bpk")).unwrap();
+        assert!(weights(&a) == weights(&b), "{kind}: the fitted weights differ");
+    }
+}
+
 #[test]
 fn a_converged_run_stops_on_its_plateau_and_says_so() {
     let dir = TempDir::new("plateau");
