@@ -259,7 +259,10 @@ pub const DEVICE_TABLE_MAX_BYTES: usize = 2 << 30;
 /// The spatial rows of every point of `data` on `device` when `on_device` (the trainer's
 /// default on a GPU): each batch then selects its rows there, instead of 640 bytes a sample
 /// copied on the CPU and uploaded with every step. `None` otherwise (on the CPU the gather is
-/// the selection), without spatial features, or past [`DEVICE_TABLE_MAX_BYTES`].
+/// the selection), without spatial features, or past [`DEVICE_TABLE_MAX_BYTES`]. Not handled
+/// yet: a GPU whose largest storage buffer is smaller than the table (Vulkan's
+/// `maxStorageBufferRange`, 128 MiB on some integrated GPUs; 4 GiB on NVIDIA's) fails to
+/// allocate it; the default run's 128 px Spot scene needs at most 26 MB (40,815 training pixels).
 pub fn device_table(
     model: &brdf_neural::ModelConfig,
     data: &TrainingData,
