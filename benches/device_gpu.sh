@@ -11,6 +11,7 @@
 #   bash benches/device_gpu.sh final     # logs packed into $OUT/final.tar.gz
 #   bash benches/device_gpu.sh e2e       # logs packed into $OUT/e2e.tar.gz (a third lease)
 #   bash benches/device_gpu.sh paper     # the full profile's one scene, all 9 models; one lease
+#   bash benches/device_gpu.sh eval      # why evaluation is slow on a GPU (next lease)
 #
 # With autotune on (the wgpu feature), the first use of every matrix-product shape in a process
 # is benchmarked, and the first process on a fresh machine also compiles every kernel and runs
@@ -155,6 +156,25 @@ if [ "$STAGE" = paper ]; then
     run 80 profile_wgpu.log $B/profile_steps /tmp/default spot__blue-acrylic \
         "${DEFAULT_STEPS:-1400}" wgpu SingleMlp
     kill $DMON
+fi
+
+if [ "$STAGE" = eval ]; then
+    # Why evaluation is slow on a GPU (40.5 s for a Single MLP at 128 px on the H200 with
+    # autotune and fusion, 1.97 s on the H100 build without them): each model is evaluated
+    # several times in one process (PROFILE_EVAL_REPEAT), so that start-up shows against the
+    # steady state, then again with autotune at its minimal level.
+    step "the default run's scenes (no training)"
+    run 40 default_scenes.log $B/profile_steps --prepare default /tmp/default
+    step "a Single MLP evaluated three times in one process"
+    run 150 eval_repeat.log env PROFILE_EVAL_REPEAT=3 $B/profile_steps /tmp/default \
+        spot__blue-acrylic 100 wgpu SingleMlp
+    step "the same with autotune minimal"
+    run 120 eval_minimal.log env CUBECL_AUTOTUNE_LEVEL=minimal PROFILE_EVAL_REPEAT=2 \
+        $B/profile_steps /tmp/default spot__blue-acrylic 100 wgpu SingleMlp
+    step "the 512 px scene: FMBRDF evaluated twice"
+    run 60 full_scene.log $B/profile_steps --prepare benches/profiles/paper_one_scene.toml /tmp/full
+    run 200 eval_full.log env PROFILE_EVAL_REPEAT=2 PROFILE_WARMUP_STEPS=50 $B/profile_steps \
+        /tmp/full spot__blue-acrylic 50 wgpu Fmbrdf
 fi
 
 if [ "$STAGE" = e2e ]; then

@@ -22,6 +22,9 @@
 //!
 //! `PROFILE_EVAL` (a comma-separated list of model kinds, or `none`) evaluates only those
 //! models (default: all); each evaluation's phases are also printed to stderr as it ends.
+//! `PROFILE_EVAL_REPEAT` (default 1) evaluates each model that many times in a row, so that
+//! a GPU backend's start-up in the first evaluation shows against the later ones; the table
+//! holds the last.
 //!
 //! On a GPU backend each model first trains `PROFILE_WARMUP_STEPS` steps (default 50; 0 on the
 //! CPU) in a run of its own, timed apart: burn's autotune benchmarks kernels at the first use of
@@ -65,6 +68,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let backend = brdf_neural::device::Backend::parse(rest.get(1).map_or("cpu", String::as_str))?;
     let only: Option<Vec<&str>> = rest.get(2).map(|m| m.split(',').map(str::trim).collect());
     let eval_list = std::env::var("PROFILE_EVAL").ok();
+    let eval_repeat: u32 = std::env::var("PROFILE_EVAL_REPEAT").map_or(Ok(1), |v| v.parse())?;
     let eval_only: Option<Vec<&str>> =
         eval_list.as_deref().map(|m| m.split(',').map(str::trim).collect());
     let layout = SweepLayout::new(out);
@@ -133,13 +137,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if eval_only.as_ref().is_some_and(|e| !e.contains(&kind.as_str())) {
             continue;
         }
-        let start = Instant::now();
         let fitted = FittedRun::from_trained(config, trained, layout.cache());
-        let test = eval_fitted(&fitted, &run, false, start)?;
-        let cells: Vec<String> =
-            test.phases.named().iter().map(|(name, s)| format!("{name} {s:.2}")).collect();
-        eprintln!("{kind}: evaluated in {:.2} s ({})", test.seconds, cells.join(", "));
-        evals.push((kind, test));
+        for round in 1..=eval_repeat {
+            let start = Instant::now();
+            let test = eval_fitted(&fitted, &run, false, start)?;
+            let cells: Vec<String> =
+                test.phases.named().iter().map(|(name, s)| format!("{name} {s:.2}")).collect();
+            eprintln!(
+                "{kind}: evaluation {round} of {eval_repeat} in {:.2} s ({})",
+                test.seconds,
+                cells.join(", ")
+            );
+            if round == eval_repeat {
+                evals.push((kind.clone(), test));
+            }
+        }
     }
     println!(
         "\n| model | records | predict | images | reciprocity | energy | curve | probe | total (s) |"
