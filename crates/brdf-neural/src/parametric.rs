@@ -115,6 +115,16 @@ fn scalar_param(x: f64, device: &Device) -> Param<Tensor<2>> {
     Param::from_tensor(Tensor::from_data(TensorData::new(vec![x as f32], [1, 1]), device))
 }
 
+/// sigmoid(z) of every column at once, with the roughness column `half` scaled by 0.5 first
+/// (one element-wise pass over the contiguous outputs; the same values as a sigmoid per column,
+/// since multiplying by 1 and 0.5 is exact).
+fn sigmoid_scaled(z: Tensor<2>, half: usize) -> Tensor<2> {
+    let k = z.dims()[1];
+    let scale: Vec<f32> = (0..k).map(|i| if i == half { 0.5 } else { 1.0 }).collect();
+    let scale = Tensor::<2>::from_data(TensorData::new(scale, [1, k]), &z.device());
+    sigmoid(z * scale)
+}
+
 /// sigmoid mapped into [lo, hi].
 fn ranged(z: Tensor<2>, (lo, hi): (f64, f64)) -> Tensor<2> {
     sigmoid(z).mul_scalar(hi - lo).add_scalar(lo)
@@ -152,7 +162,16 @@ impl ParametricModel {
     /// - spatial: `[batch, spatial_dim]`
     /// - output: per-sample tensors `[batch, k]` (FMBRDF alpha and beta `[1, 1]`)
     pub fn params(&self, spatial: Tensor<2>) -> BrdfParams {
-        let z = self.mlp.forward(spatial, None);
+        self.params_of_outputs(self.mlp.forward(spatial, None))
+    }
+
+    /// The BRDF parameters of each sample from the parameter MLP's raw outputs (the output
+    /// nonlinearities of the module table).
+    ///
+    /// # Shapes
+    /// - z: `[batch, outputs]` ([`Analytic::outputs`])
+    /// - output: as [`ParametricModel::params`]
+    pub fn params_of_outputs(&self, z: Tensor<2>) -> BrdfParams {
         let col = |k: usize, n: usize| z.clone().narrow(1, k, n);
         match self.analytic {
             Analytic::RealisticPhong => {
@@ -165,26 +184,34 @@ impl ParametricModel {
                 }
                 .into()
             }
-            Analytic::TorranceSparrow => TorranceSparrowTensorParams {
-                roughness: sigmoid(col(0, 1).mul_scalar(0.5)),
-                diffuse: sigmoid(col(1, 3)),
-                f0: sigmoid(col(4, 3)),
+            Analytic::TorranceSparrow => {
+                let s = sigmoid_scaled(z, 0);
+                let col = |k: usize, n: usize| s.clone().narrow(1, k, n);
+                TorranceSparrowTensorParams {
+                    roughness: col(0, 1),
+                    diffuse: col(1, 3),
+                    f0: col(4, 3),
+                }
+                .into()
             }
-            .into(),
-            Analytic::Disney => DisneyTensorParams {
-                base_color: sigmoid(col(0, 3)),
-                metallic: sigmoid(col(3, 1)),
-                subsurface: sigmoid(col(4, 1)),
-                specular: sigmoid(col(5, 1)),
-                roughness: sigmoid(col(6, 1).mul_scalar(0.5)),
-                specular_tint: sigmoid(col(7, 1)),
-                sheen: sigmoid(col(8, 1)),
-                sheen_tint: sigmoid(col(9, 1)),
-                clearcoat: sigmoid(col(10, 1)),
-                clearcoat_gloss: sigmoid(col(11, 1)),
-                gamma_base_color: self.gamma_base_color,
+            Analytic::Disney => {
+                let s = sigmoid_scaled(z, 6);
+                let col = |k: usize, n: usize| s.clone().narrow(1, k, n);
+                DisneyTensorParams {
+                    base_color: col(0, 3),
+                    metallic: col(3, 1),
+                    subsurface: col(4, 1),
+                    specular: col(5, 1),
+                    roughness: col(6, 1),
+                    specular_tint: col(7, 1),
+                    sheen: col(8, 1),
+                    sheen_tint: col(9, 1),
+                    clearcoat: col(10, 1),
+                    clearcoat_gloss: col(11, 1),
+                    gamma_base_color: self.gamma_base_color,
+                }
+                .into()
             }
-            .into(),
             Analytic::Fmbrdf => {
                 let raw = |p: &Option<Param<Tensor<2>>>| {
                     p.as_ref().expect("FMBRDF global").val().mul_scalar(FMBRDF_GLOBAL_GAIN)
@@ -208,15 +235,25 @@ impl ParametricModel {
     /// - spatial: `[batch, spatial_dim]`; geometry of `batch` pairs
     /// - output: `f` `[batch, 3]`
     pub fn forward(&self, spatial: Tensor<2>, geometry: &Geometry) -> BrdfOutput {
-        let f = match self.params(spatial) {
+        let f = self.brdf_of_outputs(self.mlp.forward(spatial, None), geometry);
+        BrdfOutput { f, diffuse: None, specular: None, xi: None }
+    }
+
+    /// The analytic BRDF of the parameters the raw outputs `z` map to (the model after its
+    /// parameter MLP; the `tensor_brdf` bench times this alone).
+    ///
+    /// # Shapes
+    /// - z: `[batch, outputs]`; geometry of `batch` pairs
+    /// - output: `f` `[batch, 3]`
+    pub fn brdf_of_outputs(&self, z: Tensor<2>, geometry: &Geometry) -> Tensor<2> {
+        match self.params_of_outputs(z) {
             BrdfParams::RealisticPhong(p) => realistic_phong(&p, geometry),
             BrdfParams::TorranceSparrow(p) => torrance_sparrow(&p, geometry),
             BrdfParams::Disney(p) => disney(&p, geometry),
             BrdfParams::Fmbrdf(p) => {
                 fmbrdf(&p, self.fm_nets.as_ref().expect("FMBRDF nets"), geometry)
             }
-        };
-        BrdfOutput { f, diffuse: None, specular: None, xi: None }
+        }
     }
 }
 

@@ -173,3 +173,57 @@ fn row_broadcasts_of_empty_and_thin_matrices_add_correctly() {
         assert_eq!(got, want, "[{rows}, {cols}]");
     }
 }
+
+#[test]
+fn element_wise_ops_on_strided_views_equal_the_scalar_ops() {
+    // Patch 6: unary and scalar ops on a non-contiguous view (a column, a block of columns, a
+    // transposed matrix, a view with an offset) walk the collapsed loop nest. Each result must
+    // be the scalar op of the viewed elements, in the view's logical order, to the bit.
+    use burn::tensor::activation::sigmoid;
+    let d = device::cpu();
+    let (rows, cols) = (1_000, 12);
+    let x = values(rows * cols, 61);
+    let t = Tensor::<2>::from_data(TensorData::new(x.clone(), [rows, cols]), &d);
+    let sig = |v: f32| {
+        if v >= 0.0 {
+            1.0 / (1.0 + (-v).exp())
+        } else {
+            let e = v.exp();
+            e / (1.0 + e)
+        }
+    };
+    let views: Vec<(&str, Tensor<2>, Vec<f32>)> = vec![
+        ("column 6", t.clone().narrow(1, 6, 1), (0..rows).map(|i| x[i * cols + 6]).collect()),
+        (
+            "columns 1..4",
+            t.clone().narrow(1, 1, 3),
+            (0..rows)
+                .flat_map(|i| (1..4).map(move |j| (i, j)))
+                .map(|(i, j)| x[i * cols + j])
+                .collect(),
+        ),
+        (
+            "transposed rows 10..20",
+            t.clone().narrow(0, 10, 10).swap_dims(0, 1),
+            (0..cols)
+                .flat_map(|j| (10..20).map(move |i| (i, j)))
+                .map(|(i, j)| x[i * cols + j])
+                .collect(),
+        ),
+    ];
+    for (what, view, elems) in views {
+        let shape = view.dims();
+        let check = |got: Tensor<2>, f: &dyn Fn(f32) -> f32, op: &str| {
+            assert_eq!(got.dims(), shape, "{what}: {op} shape");
+            let got = got.into_data().try_to_vec::<f32>().unwrap();
+            for (i, (g, &e)) in got.iter().zip(&elems).enumerate() {
+                assert_eq!(g.to_bits(), f(e).to_bits(), "{what}: {op}[{i}] of {e}");
+            }
+        };
+        check(sigmoid(view.clone()), &sig, "sigmoid");
+        check(view.clone().exp(), &|v| v.exp(), "exp");
+        check(view.clone().mul_scalar(0.3), &|v| v * 0.3, "mul_scalar");
+        check(view.clone().add_scalar(-1.5), &|v| v + -1.5, "add_scalar");
+        check(view.clone().neg(), &|v| -v, "neg");
+    }
+}

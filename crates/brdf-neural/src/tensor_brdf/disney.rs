@@ -77,25 +77,20 @@ pub fn disney(p: &DisneyTensorParams, g: &Geometry) -> Tensor<2> {
     let alpha = alpha_from_roughness(p.roughness.clone());
 
     // Evaluation.
-    let fl = g.schlick.clone().narrow(1, 0, 1);
-    let fv = g.schlick.clone().narrow(1, 1, 1);
-    let fh = g.schlick.clone().narrow(1, 2, 1);
-    let lh2r = g.lh.clone().square() * p.roughness.clone();
+    let (fl, fv, fh) = (g.schlick_l.clone(), g.schlick_v.clone(), g.schlick_h.clone());
+    let lh2r = g.lh2.clone() * p.roughness.clone();
     let fd90m1 = (lh2r.clone() + lh2r.clone()).sub_scalar(0.5);
     let diffuse =
         (fd90m1.clone() * fl.clone()).add_scalar(1.0) * (fd90m1 * fv.clone()).add_scalar(1.0);
     let fss90m1 = lh2r.sub_scalar(1.0);
     let fss = (fss90m1.clone() * fl).add_scalar(1.0) * (fss90m1 * fv).add_scalar(1.0);
-    let ss = (fss * g.inv_cos_sum.clone().sub_scalar(0.5)).add_scalar(0.5).mul_scalar(1.25);
+    let ss = (fss * g.subsurface_cos.clone()).add_scalar(0.5).mul_scalar(1.25);
     let diffuse = diffuse.clone() + (ss - diffuse) * p.subsurface.clone();
-    let spec = ggx_d(g.sin2_h.clone(), alpha.clone())
-        * (smith_visibility(g.nl.clone(), alpha.clone()) * smith_visibility(g.nv.clone(), alpha));
-    let one_minus_s2 = g.sin2_h.clone().neg().add_scalar(1.0);
-    let dr = cc_scale / (g.sin2_h.clone() + cc_a2 * one_minus_s2);
-    let fr = fh.clone().mul_scalar(0.96).add_scalar(0.04);
-    let q = g.nl.clone().ones_like().mul_scalar(0.25);
-    let clearcoat =
-        dr * fr * (smith_visibility(g.nl.clone(), q.clone()) * smith_visibility(g.nv.clone(), q));
+    let spec = ggx_d(g.sin2_h.clone(), g.cos2_h.clone(), alpha.clone())
+        * (smith_visibility(g.nl.clone(), g.nl2.clone(), alpha.clone())
+            * smith_visibility(g.nv.clone(), g.nv2.clone(), alpha));
+    let dr = cc_scale / (g.sin2_h.clone() + cc_a2 * g.cos2_h.clone());
+    let clearcoat = dr * g.clearcoat_fresnel.clone() * g.clearcoat_visibility.clone();
     let fs = cspec0.clone() + cspec0.neg().add_scalar(1.0) * fh.clone();
     (diffuse_c * diffuse + sheen_c * fh + spec * fs + clearcoat) * g.mask.clone()
 }

@@ -29,17 +29,15 @@ pub(crate) fn alpha_from_roughness(roughness: Tensor<2>) -> Tensor<2> {
     roughness.square().clamp_min(brdf_analytic::microfacet::ALPHA_MIN)
 }
 
-/// GGX D from sin^2(theta_h): alpha^2 / (pi (sin^2 + alpha^2 cos^2)^2).
-pub(crate) fn ggx_d(sin2_h: Tensor<2>, alpha: Tensor<2>) -> Tensor<2> {
+/// GGX D from sin^2 and cos^2 of theta_h: alpha^2 / (pi (sin^2 + alpha^2 cos^2)^2).
+pub(crate) fn ggx_d(sin2_h: Tensor<2>, cos2_h: Tensor<2>, alpha: Tensor<2>) -> Tensor<2> {
     let a2 = alpha.square();
-    let cos2 = sin2_h.clone().neg().add_scalar(1.0);
-    let t = sin2_h + a2.clone() * cos2;
+    let t = sin2_h + a2.clone() * cos2_h;
     a2 / (t.clone() * t).mul_scalar(std::f32::consts::PI)
 }
 
-/// Smith-GGX visibility 1 / (c + sqrt(alpha^2 + c^2 - alpha^2 c^2)).
-pub(crate) fn smith_visibility(c: Tensor<2>, alpha: Tensor<2>) -> Tensor<2> {
+/// Smith-GGX visibility 1 / (c + sqrt(alpha^2 + c^2 - alpha^2 c^2)), with c^2 given.
+pub(crate) fn smith_visibility(c: Tensor<2>, c2: Tensor<2>, alpha: Tensor<2>) -> Tensor<2> {
     let a2 = alpha.square();
-    let c2 = c.clone().square();
     (c + (a2.clone() + c2.clone() - a2 * c2).sqrt()).recip()
 }

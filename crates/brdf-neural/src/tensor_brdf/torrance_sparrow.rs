@@ -23,9 +23,10 @@ pub struct TorranceSparrowTensorParams {
 /// - output: `[batch, 3]`
 pub fn torrance_sparrow(p: &TorranceSparrowTensorParams, g: &Geometry) -> Tensor<2> {
     let a = alpha_from_roughness(p.roughness.clone());
-    let dg = ggx_d(g.sin2_h.clone(), a.clone())
-        * (smith_visibility(g.nl.clone(), a.clone()) * smith_visibility(g.nv.clone(), a));
-    let w = g.schlick.clone().narrow(1, 2, 1);
+    let dg = ggx_d(g.sin2_h.clone(), g.cos2_h.clone(), a.clone())
+        * (smith_visibility(g.nl.clone(), g.nl2.clone(), a.clone())
+            * smith_visibility(g.nv.clone(), g.nv2.clone(), a));
+    let w = g.schlick_h.clone();
     let f0 = p.f0.clone();
     let f = f0.clone() + f0.neg().add_scalar(1.0) * w;
     let diffuse = p.diffuse.clone().mul_scalar(FRAC_1_PI);

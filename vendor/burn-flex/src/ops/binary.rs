@@ -342,9 +342,13 @@ where
 
     let result: Vec<E> = match tensor.layout().contiguous_offsets() {
         Some((start, end)) => storage[start..end].iter().map(|&x| op(x, scalar)).collect(),
-        None => StridedIter::new(tensor.layout())
-            .map(|i| op(storage[i], scalar))
-            .collect(),
+        // Patch 6: a strided view walks the collapsed loop nest (see `unary_op_typed`).
+        None => crate::zip::zip_map(storage, tensor.layout(), storage, tensor.layout(), |x, _| {
+            op(x, scalar)
+        })
+        .unwrap_or_else(|| {
+            StridedIter::new(tensor.layout()).map(|i| op(storage[i], scalar)).collect()
+        }),
     };
 
     make_tensor(result, shape, dtype)

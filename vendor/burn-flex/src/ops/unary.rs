@@ -114,6 +114,18 @@ where
         );
     }
 
+    // Patch 6: a strided view (a column of a matrix, a transposed slice) walks the collapsed
+    // loop nest of `zip`, whose inner loop runs over the longest stride-invariant run, instead
+    // of visiting one block start at a time. Same elements, same order, same values.
+    if let Some(result) = crate::zip::zip_map(src, &layout, src, &layout, |x: E, _: E| op(x)) {
+        let bytes = Bytes::from_elems(result);
+        return FlexTensor::new(
+            bytes,
+            Layout::contiguous(layout.shape().clone()),
+            E::dtype(),
+        );
+    }
+
     // General path for views/slices with offset or extra storage
     let blocks = layout.strided_blocks();
     let result = match &blocks {
