@@ -32,23 +32,33 @@ pub struct DisneyTensorParams {
     pub gamma_base_color: bool,
 }
 
-/// mix(a, b, t) = a (1 - t) + b t.
-fn mix(a: Tensor<2>, b: Tensor<2>, t: Tensor<2>) -> Tensor<2> {
-    a * t.clone().neg().add_scalar(1.0) + b * t
-}
-
-/// mix(1, b, t) = (1 - t) + b t, for a scalar one.
-fn mix_one(b: Tensor<2>, t: Tensor<2>) -> Tensor<2> {
-    t.clone().neg().add_scalar(1.0) + b * t
+/// 1 - t.
+fn one_minus(t: Tensor<2>) -> Tensor<2> {
+    t.neg().add_scalar(1.0)
 }
 
 /// Evaluates Disney (twin of `brdf_analytic::Disney`).
+///
+/// The scalar model's colour terms are all affine in the base colour C and the tint colour
+/// C_tint (C over its luminance), with per-sample scalar coefficients:
+///
+/// f = C A + C_tint B + K, where, with w = 1 - metallic, s = 0.08 specular, F_H the Schlick
+/// weight of l.h and D G the GGX specular lobe,
+/// - A = w f_diffuse / pi + D G (1 - F_H) metallic,
+/// - B = D G (1 - F_H) s w specular_tint + sheen w F_H sheen_tint,
+/// - K = D G (1 - F_H) s w (1 - specular_tint) + D G F_H + sheen w F_H (1 - sheen_tint)
+///   + clearcoat;
+///
+/// and C_tint = C / lum(C) (white where the luminance is near zero), so f = C (A + B / lum) + K
+/// (or C A + B + K). Evaluated this way, everything but the last two products is `[batch, 1]`
+/// work: a third of the element-wise passes over `[batch, 3]` tensors of the term-by-term form,
+/// and none of their broadcast gradient reductions. The values are the term-by-term form's up
+/// to f32 rounding (`tests/tensor_brdf_agreement.rs` holds both to the scalar model).
 ///
 /// # Shapes
 /// - params: see [`DisneyTensorParams`]; geometry of `batch` pairs
 /// - output: `[batch, 3]`
 pub fn disney(p: &DisneyTensorParams, g: &Geometry) -> Tensor<2> {
-    // Per-sample constants (the scalar model's `new`).
     let cdlin = if p.gamma_base_color {
         p.base_color.clone().powf_scalar(2.2)
     } else {
@@ -56,28 +66,19 @@ pub fn disney(p: &DisneyTensorParams, g: &Geometry) -> Tensor<2> {
     };
     let ch = |k: usize| cdlin.clone().narrow(1, k, 1);
     let cdlum = ch(0).mul_scalar(0.3) + ch(1).mul_scalar(0.6) + ch(2).mul_scalar(0.1);
-    // White where the luminance is (near) zero, like the scalar twin; the division's floor keeps
-    // its derivative (which squares the luminance) finite in f32.
+    // C_tint = C tint_scale + tint_white: C / lum, or white where the luminance is (near) zero,
+    // like the scalar twin; the floor keeps the reciprocal's derivative (which squares the
+    // luminance) finite in f32.
     let floor = brdf_analytic::DISNEY_TINT_LUMINANCE_MIN as f32;
-    let dark = cdlum.clone().lower_equal_elem(floor).repeat_dim(1, 3);
-    let ctint = (cdlin.clone() / cdlum.clamp_min(floor)).mask_fill(dark, 1.0);
-    let dielectric = p.specular.clone().mul_scalar(0.5 * 0.16);
-    let cspec0 = mix(
-        dielectric * mix_one(ctint.clone(), p.specular_tint.clone()),
-        cdlin.clone(),
-        p.metallic.clone(),
-    );
-    let dielectric_weight = p.metallic.clone().neg().add_scalar(1.0);
-    let diffuse_c = cdlin.mul_scalar(FRAC_1_PI) * dielectric_weight.clone();
-    let sheen_c = mix_one(ctint, p.sheen_tint.clone()) * p.sheen.clone() * dielectric_weight;
-    let cc_alpha = p.clearcoat_gloss.clone().mul_scalar(0.001 - 0.1).add_scalar(0.1);
-    let cc_a2 = cc_alpha.square();
-    let cc_scale = p.clearcoat.clone().mul_scalar(0.25) * cc_a2.clone().sub_scalar(1.0)
-        / cc_a2.clone().log().mul_scalar(PI);
-    let alpha = alpha_from_roughness(p.roughness.clone());
+    let dark = cdlum.clone().lower_equal_elem(floor);
+    let tint_scale = cdlum.clamp_min(floor).recip().mask_fill(dark.clone(), 0.0);
+    let tint_white = dark.float();
+    let w = one_minus(p.metallic.clone());
+    let dielectric_w = p.specular.clone().mul_scalar(0.5 * 0.16) * w.clone();
+    let fh = g.schlick_h.clone();
 
-    // Evaluation.
-    let (fl, fv, fh) = (g.schlick_l.clone(), g.schlick_v.clone(), g.schlick_h.clone());
+    // Diffuse with retro-reflection, blended with the Hanrahan-Krueger subsurface term.
+    let (fl, fv) = (g.schlick_l.clone(), g.schlick_v.clone());
     let lh2r = g.lh2.clone() * p.roughness.clone();
     let fd90m1 = (lh2r.clone() + lh2r.clone()).sub_scalar(0.5);
     let diffuse =
@@ -86,11 +87,31 @@ pub fn disney(p: &DisneyTensorParams, g: &Geometry) -> Tensor<2> {
     let fss = (fss90m1.clone() * fl).add_scalar(1.0) * (fss90m1 * fv).add_scalar(1.0);
     let ss = (fss * g.subsurface_cos.clone()).add_scalar(0.5).mul_scalar(1.25);
     let diffuse = diffuse.clone() + (ss - diffuse) * p.subsurface.clone();
+
+    // GGX specular lobe D G, and its share 1 - F_H that takes the specular colour.
+    let alpha = alpha_from_roughness(p.roughness.clone());
     let spec = ggx_d(g.sin2_h.clone(), g.cos2_h.clone(), alpha.clone())
         * (smith_visibility(g.nl.clone(), g.nl2.clone(), alpha.clone())
             * smith_visibility(g.nv.clone(), g.nv2.clone(), alpha));
+    let spec_tinted = spec.clone() * one_minus(fh.clone());
+
+    // GTR1 clearcoat (colourless).
+    let cc_alpha = p.clearcoat_gloss.clone().mul_scalar(0.001 - 0.1).add_scalar(0.1);
+    let cc_a2 = cc_alpha.square();
+    let cc_scale = p.clearcoat.clone().mul_scalar(0.25) * cc_a2.clone().sub_scalar(1.0)
+        / cc_a2.clone().log().mul_scalar(PI);
     let dr = cc_scale / (g.sin2_h.clone() + cc_a2 * g.cos2_h.clone());
     let clearcoat = dr * g.clearcoat_fresnel.clone() * g.clearcoat_visibility.clone();
-    let fs = cspec0.clone() + cspec0.neg().add_scalar(1.0) * fh.clone();
-    (diffuse_c * diffuse + sheen_c * fh + spec * fs + clearcoat) * g.mask.clone()
+
+    let sheen = p.sheen.clone() * w.clone() * fh.clone();
+    let a = (w * diffuse).mul_scalar(FRAC_1_PI) + spec_tinted.clone() * p.metallic.clone();
+    let b = spec_tinted.clone() * dielectric_w.clone() * p.specular_tint.clone()
+        + sheen.clone() * p.sheen_tint.clone();
+    let k = spec_tinted * dielectric_w * one_minus(p.specular_tint.clone())
+        + spec * fh
+        + sheen * one_minus(p.sheen_tint.clone())
+        + clearcoat;
+    let a = (a + b.clone() * tint_scale) * g.mask.clone();
+    let k = (k + b * tint_white) * g.mask.clone();
+    cdlin * a + k
 }
