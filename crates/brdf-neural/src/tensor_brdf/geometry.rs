@@ -9,6 +9,7 @@
 use angles::Vec3;
 use brdf_analytic::microfacet::{PairGeometry, schlick_weight};
 use burn::tensor::{Device, Tensor, TensorData};
+use rayon::prelude::*;
 
 /// FMBRDF's cosine clamp epsilon (official code: 1e-6).
 pub(crate) const COS_EPS: f64 = 1e-6;
@@ -108,6 +109,90 @@ impl Geometry {
     pub fn new(l: &[Vec3<f32>], v: &[Vec3<f32>], fmbrdf: bool, device: &Device) -> Self {
         assert_eq!(l.len(), v.len(), "Geometry: l and v lengths");
         let n = l.len();
+        // Chunks of pairs on every thread, each into its own term-major buffers, then each
+        // term's row assembled from the chunks in order.
+        let parts: Vec<Terms> = l
+            .par_chunks(PAIRS_PER_TASK)
+            .zip(v.par_chunks(PAIRS_PER_TASK))
+            .map(|(l, v)| Terms::of(l, v, fmbrdf))
+            .collect();
+        let rows = |count: usize, of: fn(&Terms) -> &[f32]| {
+            let mut out = Vec::with_capacity(n * count);
+            for k in 0..count {
+                for p in &parts {
+                    out.extend_from_slice(&of(p)[k * p.len..(k + 1) * p.len]);
+                }
+            }
+            out
+        };
+        let base = rows(N_BASE, |p| &p.base);
+        let fm = if fmbrdf { rows(N_FM, |p| &p.fm) } else { Vec::new() };
+        let body: Vec<f32> = parts.iter().flat_map(|p| p.body.iter().copied()).collect();
+        let t = Tensor::<2>::from_data(TensorData::new(base, [N_BASE, n]), device);
+        let row = |t: &Tensor<2>, k: usize| t.clone().narrow(0, k, 1).reshape([n, 1]);
+        let c = |k: usize| row(&t, k);
+        let fmbrdf = fmbrdf.then(|| {
+            let t = Tensor::<2>::from_data(TensorData::new(fm, [N_FM, n]), device);
+            let c = |k: usize| row(&t, k);
+            FmbrdfGeometry {
+                nl: c(0),
+                nv: c(1),
+                nh: c(2),
+                theta_h: c(3),
+                cos_h: c(4),
+                cos_r: c(5),
+                sin_r: c(6),
+                tan_lv: t.clone().narrow(0, 7, 2).reshape([2 * n, 1]),
+                body: Tensor::from_data(TensorData::new(body, [n, N_BODY]), device),
+            }
+        });
+        Self {
+            mask: c(0),
+            nl: c(1),
+            nv: c(2),
+            nl2: c(3),
+            nv2: c(4),
+            sin2_h: c(5),
+            cos2_h: c(6),
+            lh2: c(7),
+            schlick_l: c(8),
+            schlick_v: c(9),
+            schlick_h: c(10),
+            subsurface_cos: c(11),
+            clearcoat_fresnel: c(12),
+            clearcoat_visibility: c(13),
+            rv: c(14),
+            rv_positive: c(15),
+            fmbrdf,
+        }
+    }
+
+    /// Number of pairs.
+    pub fn len(&self) -> usize {
+        self.mask.dims()[0]
+    }
+
+    /// Whether the batch is empty.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// Pairs a rayon task computes the terms of.
+const PAIRS_PER_TASK: usize = 1024;
+
+/// The terms of a run of pairs: `base` and `fm` term-major (`len` values of the first term,
+/// then of the second, ...), `body` pair-major.
+struct Terms {
+    len: usize,
+    base: Vec<f32>,
+    fm: Vec<f32>,
+    body: Vec<f32>,
+}
+
+impl Terms {
+    fn of(l: &[Vec3<f32>], v: &[Vec3<f32>], fmbrdf: bool) -> Self {
+        let n = l.len();
         let mut base = vec![0.0_f32; n * N_BASE];
         let mut fm = vec![0.0_f32; if fmbrdf { n * N_FM } else { 0 }];
         let mut body = Vec::with_capacity(if fmbrdf { n * N_BODY } else { 0 });
@@ -156,53 +241,7 @@ impl Geometry {
                 body.extend_from_slice(&b);
             }
         }
-        let t = Tensor::<2>::from_data(TensorData::new(base, [N_BASE, n]), device);
-        let row = |t: &Tensor<2>, k: usize| t.clone().narrow(0, k, 1).reshape([n, 1]);
-        let c = |k: usize| row(&t, k);
-        let fmbrdf = fmbrdf.then(|| {
-            let t = Tensor::<2>::from_data(TensorData::new(fm, [N_FM, n]), device);
-            let c = |k: usize| row(&t, k);
-            FmbrdfGeometry {
-                nl: c(0),
-                nv: c(1),
-                nh: c(2),
-                theta_h: c(3),
-                cos_h: c(4),
-                cos_r: c(5),
-                sin_r: c(6),
-                tan_lv: t.clone().narrow(0, 7, 2).reshape([2 * n, 1]),
-                body: Tensor::from_data(TensorData::new(body, [n, N_BODY]), device),
-            }
-        });
-        Self {
-            mask: c(0),
-            nl: c(1),
-            nv: c(2),
-            nl2: c(3),
-            nv2: c(4),
-            sin2_h: c(5),
-            cos2_h: c(6),
-            lh2: c(7),
-            schlick_l: c(8),
-            schlick_v: c(9),
-            schlick_h: c(10),
-            subsurface_cos: c(11),
-            clearcoat_fresnel: c(12),
-            clearcoat_visibility: c(13),
-            rv: c(14),
-            rv_positive: c(15),
-            fmbrdf,
-        }
-    }
-
-    /// Number of pairs.
-    pub fn len(&self) -> usize {
-        self.mask.dims()[0]
-    }
-
-    /// Whether the batch is empty.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
+        Self { len: n, base, fm, body }
     }
 }
 
