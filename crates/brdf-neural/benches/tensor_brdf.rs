@@ -10,7 +10,9 @@
 //! - `BRDF_BENCH_QUICK=1` skips the criterion groups and prints the medians of 31 passes
 //!   (`BRDF_BENCH_PASSES`, for a profiler).
 //!
-//! Each model's line also prints the loss and a hash of the gradient of the raw outputs, so
+//! Each model also gets a line with the time of `Geometry::new` for its pairs (the batch's
+//! direction-only terms, computed on the CPU in the training step's encode phase). Each model's
+//! timing line also prints the loss and a hash of the gradient of the raw outputs, so
 //! that a rewrite meant to keep the values to the bit can be checked against the build before.
 
 use brdf_neural::device;
@@ -31,6 +33,7 @@ struct Case {
     z: Vec<f32>,
     outputs: usize,
     geometry: Geometry,
+    pairs: (Vec<[f32; 3]>, Vec<[f32; 3]>),
     target: Tensor<2>,
     device: Device,
 }
@@ -61,7 +64,8 @@ impl Case {
         let geometry = Geometry::new(&l, &v, kind == ModelKind::Fmbrdf, device);
         let t: Vec<f32> = (0..n * 3).map(|_| uniform()).collect();
         let target = Tensor::from_data(TensorData::new(t, [n, 3]), device);
-        Self { name, model, z, outputs, geometry, target, device: device.clone() }
+        let pairs = (l, v);
+        Self { name, model, z, outputs, geometry, pairs, target, device: device.clone() }
     }
 
     /// Forward and backward once; returns the loss and a hash of the raw outputs' gradient.
@@ -114,6 +118,16 @@ fn bench(c: &mut Criterion) {
             })
             .collect();
         t.sort_by(f64::total_cmp);
+        let fm = case.name == "fmbrdf";
+        let mut tg: Vec<f64> = (0..31)
+            .map(|_| {
+                let t0 = Instant::now();
+                std::hint::black_box(Geometry::new(&case.pairs.0, &case.pairs.1, fm, &case.device));
+                t0.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        tg.sort_by(f64::total_cmp);
+        println!("  {:<8} geometry {:>6.3} ms", case.name, tg[tg.len() / 2]);
         let (loss, hash) = case.step();
         println!(
             "  {:<8} {:>7.2}   loss {loss:e}, gradient hash {hash:016x}",

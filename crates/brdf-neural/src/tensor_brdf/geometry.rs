@@ -120,7 +120,7 @@ impl Geometry {
             let mut out = Vec::with_capacity(n * count);
             for k in 0..count {
                 for p in &parts {
-                    out.extend_from_slice(&of(p)[k * p.len..(k + 1) * p.len]);
+                    out.extend_from_slice(&of(p)[k * p.stride..k * p.stride + p.len]);
                 }
             }
             out
@@ -182,9 +182,16 @@ impl Geometry {
 const PAIRS_PER_TASK: usize = 1024;
 
 /// The terms of a run of pairs: `base` and `fm` term-major (`len` values of the first term,
-/// then of the second, ...), `body` pair-major.
+/// then of the second, ..., each term's run starting `stride` values after the previous one's),
+/// `body` pair-major.
+///
+/// The stride is `len` plus one cache line: with a stride of exactly `len` (a multiple of 4 KiB
+/// for full chunks), the 16 writes of one pair land in the same L1 cache set and evict each
+/// other (measured: Geometry::new of 8,192 pairs took 0.8 ms on one core that way, against
+/// 0.2 ms before the terms were stored term-major).
 struct Terms {
     len: usize,
+    stride: usize,
     base: Vec<f32>,
     fm: Vec<f32>,
     body: Vec<f32>,
@@ -193,8 +200,9 @@ struct Terms {
 impl Terms {
     fn of(l: &[Vec3<f32>], v: &[Vec3<f32>], fmbrdf: bool) -> Self {
         let n = l.len();
-        let mut base = vec![0.0_f32; n * N_BASE];
-        let mut fm = vec![0.0_f32; if fmbrdf { n * N_FM } else { 0 }];
+        let stride = n + 16;
+        let mut base = vec![0.0_f32; stride * N_BASE];
+        let mut fm = vec![0.0_f32; if fmbrdf { stride * N_FM } else { 0 }];
         let mut body = Vec::with_capacity(if fmbrdf { n * N_BODY } else { 0 });
         let up = [0.0_f32, 0.0, 1.0];
         // The clearcoat's alpha: 0.25 exactly, squared as the tensor twin squares it.
@@ -227,7 +235,7 @@ impl Terms {
                 f32::from(u8::from(rv_pos)),
             ];
             for (k, t) in terms.into_iter().enumerate() {
-                base[k * n + i] = t;
+                base[k * stride + i] = t;
             }
             if fmbrdf {
                 let (lu, vu) = match (unit(li), unit(vi)) {
@@ -236,12 +244,12 @@ impl Terms {
                 };
                 let (terms, b) = fm_terms(lu, vu);
                 for (k, t) in terms.into_iter().enumerate() {
-                    fm[k * n + i] = t;
+                    fm[k * stride + i] = t;
                 }
                 body.extend_from_slice(&b);
             }
         }
-        Self { len: n, base, fm, body }
+        Self { len: n, stride, base, fm, body }
     }
 }
 
