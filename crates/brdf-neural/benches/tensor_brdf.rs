@@ -14,6 +14,11 @@
 //! direction-only terms, computed on the CPU in the training step's encode phase). Each model's
 //! timing line also prints the loss and a hash of the gradient of the raw outputs, so
 //! that a rewrite meant to keep the values to the bit can be checked against the build before.
+//!
+//! Measured 2026-11-27 on the 2-core Intel Xeon (no AVX512-BF16), batch 8,192, medians of 31:
+//! Disney 9.26 and 9.94 ms at the start of the session, 5.13 to 5.46 ms after the changes of
+//! `benches/README.md` ("Disney's analytic half in fewer passes"); TS 3.26 -> 2.87 ms, RP 3.34
+//! -> 3.08 ms; FMBRDF 44 to 51 ms (its two helper networks run per sample).
 
 use brdf_neural::device;
 use brdf_neural::tensor_brdf::Geometry;
