@@ -11,7 +11,7 @@
 #   bash benches/device_gpu.sh final     # logs packed into $OUT/final.tar.gz
 #   bash benches/device_gpu.sh e2e       # logs packed into $OUT/e2e.tar.gz (a third lease)
 #   bash benches/device_gpu.sh paper     # the full profile's one scene, all 9 models; one lease
-#   bash benches/device_gpu.sh eval      # why evaluation is slow on a GPU (next lease)
+#   bash benches/device_gpu.sh eval      # evaluation's start-up, previous build against this one
 #
 # With autotune on (the wgpu feature), the first use of every matrix-product shape in a process
 # is benchmarked, and the first process on a fresh machine also compiles every kernel and runs
@@ -159,22 +159,40 @@ if [ "$STAGE" = paper ]; then
 fi
 
 if [ "$STAGE" = eval ]; then
-    # Why evaluation is slow on a GPU (40.5 s for a Single MLP at 128 px on the H200 with
-    # autotune and fusion, 1.97 s on the H100 build without them): each model is evaluated
-    # several times in one process (PROFILE_EVAL_REPEAT), so that start-up shows against the
-    # steady state, then again with autotune at its minimal level.
+    # Evaluation's start-up on a GPU (benches/README.md, "Why evaluation was slow on a GPU"):
+    # a Single MLP fitted and evaluated three times in one process (PROFILE_EVAL_REPEAT: the
+    # first evaluation pays for new kernel shapes, the later ones are the steady state), by the
+    # previous build (`.devrun_old`, when carried: passes padded to powers of two) and by this
+    # one (padded and split into the training loop's parts of 512 rows). The NVIDIA driver's
+    # shader cache is off and so is CubeCL's persistent autotune cache, so that neither process
+    # reuses the other's compilations; CubeCL logs each kernel compiled and each autotune
+    # decision. Then FMBRDF at the paper's 512 px, evaluated once (its phases).
+    export __GL_SHADER_DISK_CACHE=0
     step "the default run's scenes (no training)"
     run 40 default_scenes.log $B/profile_steps --prepare default /tmp/default
-    step "a Single MLP evaluated three times in one process"
-    run 150 eval_repeat.log env PROFILE_EVAL_REPEAT=3 $B/profile_steps /tmp/default \
+    logged() { # logged NAME: cubecl.toml logging compilations and tuning to $LOGS/NAME-*.log
+        rm -f "$LOGS/$1"-*.log
+        printf '[compilation.logger]\nlevel = "basic"\nfile = "%s"\n' "$LOGS/$1-compile.log" >cubecl.toml
+        printf '[autotune]\ndisable_cache = true\n[autotune.logger]\nlevel = "minimal"\nfile = "%s"\n' \
+            "$LOGS/$1-autotune.log" >>cubecl.toml
+    }
+    if [ -f .devrun_old/bin.tar.xz ]; then
+        mkdir -p /tmp/old && tar -xJf .devrun_old/bin.tar.xz -C /tmp/old
+        logged old
+        step "the previous build: a Single MLP evaluated three times"
+        run 130 eval_old.log env PROFILE_EVAL_REPEAT=3 /tmp/old/bin/profile_steps /tmp/default \
+            spot__blue-acrylic 100 wgpu SingleMlp
+    fi
+    logged new
+    step "this build: the same"
+    run 130 eval_new.log env PROFILE_EVAL_REPEAT=3 $B/profile_steps /tmp/default \
         spot__blue-acrylic 100 wgpu SingleMlp
-    step "the same with autotune minimal"
-    run 120 eval_minimal.log env CUBECL_AUTOTUNE_LEVEL=minimal PROFILE_EVAL_REPEAT=2 \
-        $B/profile_steps /tmp/default spot__blue-acrylic 100 wgpu SingleMlp
-    step "the 512 px scene: FMBRDF evaluated twice"
-    run 60 full_scene.log $B/profile_steps --prepare benches/profiles/paper_one_scene.toml /tmp/full
-    run 200 eval_full.log env PROFILE_EVAL_REPEAT=2 PROFILE_WARMUP_STEPS=50 $B/profile_steps \
-        /tmp/full spot__blue-acrylic 50 wgpu Fmbrdf
+    rm -f cubecl.toml
+    wc -l "$LOGS"/*-compile.log "$LOGS"/*-autotune.log
+    step "the 512 px scene: FMBRDF evaluated once"
+    run 30 full_scene.log $B/profile_steps --prepare benches/profiles/paper_one_scene.toml /tmp/full
+    run 300 eval_full.log env PROFILE_WARMUP_STEPS=0 $B/profile_steps /tmp/full \
+        spot__blue-acrylic 50 wgpu Fmbrdf
 fi
 
 if [ "$STAGE" = e2e ]; then

@@ -143,6 +143,23 @@ impl Backend {
     }
 }
 
+/// Whether `device` (with or without autodiff) is a CPU backend's device (flex or ndarray);
+/// every other device this crate makes is a GPU's.
+pub fn is_cpu_device(device: &Device) -> bool {
+    let inner = device.clone().inner();
+    #[cfg(feature = "flex")]
+    if inner == Device::flex() {
+        return true;
+    }
+    #[cfg(feature = "ndarray")]
+    #[allow(deprecated)]
+    if inner == Device::ndarray() {
+        return true;
+    }
+    let _ = inner;
+    false
+}
+
 /// The default CPU device: flex when built, else ndarray.
 ///
 /// # Panics
@@ -171,6 +188,8 @@ mod tests {
         assert_eq!(Backend::parse("cpu").unwrap(), Backend::default());
         assert!(Backend::parse("metal").is_err());
         assert!(Backend::available().contains(&Backend::default()));
+        assert!(is_cpu_device(&cpu()));
+        assert!(is_cpu_device(&cpu_training()));
     }
 
     #[test]

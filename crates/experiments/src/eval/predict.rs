@@ -3,11 +3,34 @@
 
 use crate::data::TrainingData;
 use crate::{Error, Result};
-use brdf_neural::{BrdfModel, ModelConfig, Samples};
+use brdf_neural::{BrdfModel, ModelConfig, Samples, batch_split};
 use burn::tensor::{Device, Tensor};
 
 /// Rows per forward pass.
 pub const CHUNK: usize = 1 << 15;
+
+/// The fewest rows a forward pass on a GPU runs (see [`pass_rows`]).
+pub const MIN_GPU_ROWS: usize = 1 << 10;
+
+/// The rows a forward pass of `n` samples runs: `n` on a CPU; on a GPU, `n` rounded up to a
+/// power of two of at least [`MIN_GPU_ROWS`] (to a multiple of [`CHUNK`] above it), the extra
+/// rows padding that is dropped.
+///
+/// An evaluation's passes come in many sizes (the tail of every chunked pass, the probes'
+/// 179-direction slices). On a GPU with autotune, the first product of every new shape
+/// benchmarks candidate kernels, compiling each: 2 to 7 s a shape on a fresh H200, and an odd
+/// row count also changes the kernels' vector width. Rounded to powers of two and run in the
+/// training loop's parts of 512 rows ([`forward_rows`]), every pass reuses the shapes training
+/// tuned (benches/README.md, "Why evaluation was slow on a GPU").
+pub fn pass_rows(n: usize, gpu: bool) -> usize {
+    if !gpu || n == 0 {
+        n
+    } else if n >= CHUNK {
+        n.div_ceil(CHUNK) * CHUNK
+    } else {
+        n.next_power_of_two().max(MIN_GPU_ROWS)
+    }
+}
 
 /// A model's outputs on a set of records.
 #[derive(Clone, Debug, Default)]
@@ -38,7 +61,40 @@ pub fn forward_rows(
     device: &Device,
     parts: bool,
 ) -> Result<Prediction> {
-    let batch = config.batch(samples, None, device)?;
+    let gpu = !brdf_neural::device::is_cpu_device(device);
+    let rows = pass_rows(samples.l.len(), gpu);
+    // On a GPU, the training loop's parts of 512 rows (`batch_split::gpu_parts`): every pass of
+    // an evaluation then meets the matrix-product shapes that training tuned.
+    let _split = gpu.then(|| batch_split::scope(batch_split::gpu_parts(rows)));
+    forward_padded(model, config, samples, device, parts, rows)
+}
+
+/// [`forward_rows`] run on `padded_n` (at least the samples') rows.
+fn forward_padded(
+    model: &BrdfModel,
+    config: &ModelConfig,
+    samples: &Samples,
+    device: &Device,
+    parts: bool,
+    padded_n: usize,
+) -> Result<Prediction> {
+    let n = samples.l.len();
+    let pad = padded_n.saturating_sub(n);
+    // Padding rows: zero features and a valid (l, v) pair; their outputs are dropped.
+    let mut spatial = Vec::with_capacity(samples.spatial.len() + pad * config.spatial_dim);
+    spatial.extend_from_slice(samples.spatial);
+    spatial.resize(spatial.len() + pad * config.spatial_dim, 0.0);
+    let padded = |d: &[[f32; 3]]| [d, &vec![[0.0, 0.0, 1.0]; pad]].concat();
+    let batch = if pad == 0 {
+        config.batch_owned(spatial, samples.l, samples.v, None, device)?
+    } else {
+        config.batch_owned(spatial, &padded(samples.l), &padded(samples.v), None, device)?
+    };
+    let rows = |t: Tensor<2>, what: &str| -> Result<Vec<[f32; 3]>> {
+        let mut r = rows(t, what)?;
+        r.truncate(n);
+        Ok(r)
+    };
     let out = model.forward(&batch);
     let mut p = Prediction { f: rows(out.f, "f")?, ..Default::default() };
     if parts && let (Some(d), Some(s)) = (out.diffuse, out.specular) {
@@ -119,5 +175,88 @@ impl metrics::BatchBrdf for ModelBrdf<'_> {
     /// The backend parallelises each forward pass itself.
     fn parallel(&self) -> bool {
         false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use brdf_neural::ModelKind;
+
+    #[test]
+    fn gpu_passes_round_up_to_few_shapes_and_cpu_passes_do_not() {
+        assert_eq!(pass_rows(179, false), 179);
+        assert_eq!(pass_rows(0, true), 0);
+        assert_eq!(pass_rows(179, true), MIN_GPU_ROWS);
+        assert_eq!(pass_rows(4_000, true), 4_096);
+        assert_eq!(pass_rows(CHUNK, true), CHUNK);
+        assert_eq!(pass_rows(CHUNK + 1, true), 2 * CHUNK);
+    }
+
+    /// `n` samples of 4 spatial features: (spatial, l, v).
+    #[allow(clippy::type_complexity)]
+    fn inputs(n: usize) -> (Vec<f32>, Vec<[f32; 3]>, Vec<[f32; 3]>) {
+        let spatial: Vec<f32> = (0..n * 4).map(|i| (i as f32 * 0.37).sin()).collect();
+        let dirs = |s: f32| -> Vec<[f32; 3]> {
+            (0..n)
+                .map(|i| {
+                    let a = 0.02 * i as f32 + s;
+                    [a.sin() * 0.6, a.cos() * 0.6, 0.8]
+                })
+                .collect()
+        };
+        (spatial, dirs(0.1), dirs(1.3))
+    }
+
+    #[test]
+    fn padded_passes_give_the_unpadded_values() {
+        let device = brdf_neural::device::cpu();
+        for kind in [ModelKind::SingleMlp, ModelKind::AdditiveSharedEnhanced, ModelKind::Disney] {
+            let config = ModelConfig { spatial_dim: 4, ..ModelConfig::new(kind) };
+            let model = config.init(&device).unwrap();
+            let n = 37;
+            let (spatial, l, v) = inputs(n);
+            let samples = Samples { spatial: &spatial, l: &l, v: &v };
+            let plain = forward_padded(&model, &config, &samples, &device, true, n).unwrap();
+            let padded = forward_padded(&model, &config, &samples, &device, true, 1024).unwrap();
+            let specular = (plain.specular.as_ref(), padded.specular.as_ref());
+            assert_eq!(specular.0.is_some(), kind.is_additive());
+            assert_eq!(specular.1.is_some(), kind.is_additive());
+            for (a, b) in [(Some(&plain.f), Some(&padded.f)), specular] {
+                let (Some(a), Some(b)) = (a, b) else { continue };
+                assert_eq!(a.len(), n);
+                assert_eq!(b.len(), n);
+                for (x, y) in a.iter().flatten().zip(b.iter().flatten()) {
+                    assert!((x - y).abs() <= 1e-6 * x.abs().max(1.0), "{kind:?}: {x} against {y}");
+                }
+            }
+        }
+    }
+
+    /// On a GPU (`cargo test -p experiments --features wgpu`, lavapipe will do), a pass padded
+    /// to a power of two and split into parts of 512 rows gives the CPU's values.
+    #[cfg(feature = "wgpu")]
+    #[test]
+    fn gpu_passes_padded_and_split_give_the_cpus_values() {
+        use brdf_neural::device::Backend;
+        use burn::module::Module;
+        let cpu = brdf_neural::device::cpu();
+        let gpu = Backend::Wgpu.device().unwrap();
+        assert!(!brdf_neural::device::is_cpu_device(&gpu));
+        for kind in [ModelKind::SingleMlp, ModelKind::Disney] {
+            let config = ModelConfig { spatial_dim: 4, ..ModelConfig::new(kind) };
+            let model = config.init(&cpu).unwrap();
+            let on_gpu = model.clone().fork(&gpu);
+            for n in [37, 1_500] {
+                let (spatial, l, v) = inputs(n);
+                let samples = Samples { spatial: &spatial, l: &l, v: &v };
+                let want = forward_rows(&model, &config, &samples, &cpu, false).unwrap().f;
+                let got = forward_rows(&on_gpu, &config, &samples, &gpu, false).unwrap().f;
+                assert_eq!(got.len(), n);
+                for (x, y) in want.iter().flatten().zip(got.iter().flatten()) {
+                    assert!((x - y).abs() <= 1e-4 * x.abs().max(1e-3), "{kind:?}: {x} against {y}");
+                }
+            }
+        }
     }
 }
