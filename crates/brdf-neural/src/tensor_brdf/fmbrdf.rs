@@ -79,7 +79,9 @@ pub fn fmbrdf(p: &FmbrdfTensorParams, nets: &FmbrdfNets, g: &Geometry) -> Tensor
     let n = g.len();
     let device = g.mask.device();
     let c = fmbrdf_normalization(p.alpha.clone(), p.beta.clone(), &device);
-    let lambda = nets.lambda(fm.tan_lv.clone(), p.alpha.clone(), p.beta.clone()).add_scalar(1.0);
+    let lambda = nets
+        .lambda(fm.tan_lv.clone(), &fm.tan_lv_host, p.alpha.clone(), p.beta.clone())
+        .add_scalar(1.0);
     let g_smith = (lambda.clone().narrow(0, 0, n) * lambda.narrow(0, n, n)).recip();
     let dist = (fm.theta_h.clone() / p.alpha.clone()).powf(p.beta.clone()).neg().exp()
         * c

@@ -9,6 +9,7 @@
 use angles::Vec3;
 use brdf_analytic::microfacet::{PairGeometry, schlick_weight};
 use burn::tensor::{Device, Tensor, TensorData};
+use std::sync::Arc;
 
 /// FMBRDF's cosine clamp epsilon (official code: 1e-6).
 pub(crate) const COS_EPS: f64 = 1e-6;
@@ -79,6 +80,9 @@ pub struct FmbrdfGeometry {
     pub sin_r: Tensor<2>,
     /// tan(theta_l), tan(theta_v) stacked: `[2 batch, 1]`.
     pub tan_lv: Tensor<2>,
+    /// The same values on the host, for the Lambda network's segment search
+    /// ([`super::FmbrdfNets::lambda`]).
+    pub tan_lv_host: Arc<[f32]>,
     /// Body-network frame features (n''_x, n''_y, n''_z, l''_x, l''_z, n''.l''): `[batch, 6]`.
     pub body: Tensor<2>,
 }
@@ -122,6 +126,7 @@ impl Geometry {
         let row = |t: &Tensor<2>, k: usize| t.clone().narrow(0, k, 1).reshape([n, 1]);
         let c = |k: usize| row(&t, k);
         let fmbrdf = fmbrdf.then(|| {
+            let tan_lv_host: Arc<[f32]> = fm[7 * n..9 * n].into();
             let t = Tensor::<2>::from_data(TensorData::new(fm, [N_FM, n]), device);
             let c = |k: usize| row(&t, k);
             FmbrdfGeometry {
@@ -133,6 +138,7 @@ impl Geometry {
                 cos_r: c(5),
                 sin_r: c(6),
                 tan_lv: t.clone().narrow(0, 7, 2).reshape([2 * n, 1]),
+                tan_lv_host,
                 body: Tensor::from_data(TensorData::new(terms.body, [n, N_BODY]), device),
             }
         });

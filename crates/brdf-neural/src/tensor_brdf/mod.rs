@@ -12,6 +12,7 @@ mod disney;
 mod fmbrdf;
 mod fmbrdf_nets;
 mod geometry;
+mod lambda_segments;
 mod phong;
 mod torrance_sparrow;
 
