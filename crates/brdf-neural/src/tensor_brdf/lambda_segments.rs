@@ -118,7 +118,8 @@ mod tests {
                     let z = a[j] as f64 + x as f64 * c[j] as f64;
                     let scale = a[j].abs() as f64 + (x * c[j]).abs() as f64;
                     if z.abs() > 1e-5 * scale.max(1e-30) {
-                        prop_assert_eq!(row[j], if z > 0.0 { 1.0 } else { 0.0 }, "unit {} t {}", j, x);
+                        let active = if z > 0.0 { 1.0 } else { 0.0 };
+                        prop_assert_eq!(row[j], active, "unit {} t {}", j, x);
                     }
                 }
             }
