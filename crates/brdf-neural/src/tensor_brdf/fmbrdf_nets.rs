@@ -189,9 +189,13 @@ mod tests {
             s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             (s >> 40) as f32 / (1u64 << 24) as f32
         };
-        for (alpha, beta) in
-            [(0.001_f32, 0.5_f32), (0.05, 0.7), (0.3, 2.0), (1.0, 3.5), (6.28, 4.0)]
-        {
+        for (alpha, beta) in [
+            (0.001_f32, 0.5_f32),
+            (0.05, 0.7),
+            (0.3, 2.0),
+            (1.0, 3.5),
+            (std::f32::consts::TAU, 4.0),
+        ] {
             // Mostly moderate angles, some grazing ones, and repeated and zero values.
             let mut t: Vec<f32> = (0..3_000)
                 .map(|i| match i % 10 {
