@@ -59,6 +59,22 @@ impl MatmulPrecision {
         PrecisionGuard { previous: Some(set(MatmulPrecision::F32)) }
     }
 
+    /// Whether this CPU has Intel's AMX-BF16 tile unit (Xeons from Sapphire Rapids on; CPUID
+    /// leaf 7, EDX bit 22). Our bf16 kernel does not use it: it runs on AVX512-BF16, and on
+    /// such a Xeon it was measured slower than f32 (`benches/README.md`, "bf16 on an Intel Xeon
+    /// with AMX"), so the trainer warns there.
+    pub fn cpu_has_amx_bf16() -> bool {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{__cpuid, __cpuid_count};
+            __cpuid(0).eax >= 7 && (__cpuid_count(7, 0).edx >> 22) & 1 == 1
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            false
+        }
+    }
+
     /// Whether this CPU runs bf16 products natively (otherwise they are emulated, slowly).
     pub fn bf16_native() -> bool {
         #[cfg(feature = "flex")]
@@ -101,4 +117,22 @@ fn set(p: MatmulPrecision) -> MatmulPrecision {
 #[cfg(not(feature = "flex"))]
 fn set(_: MatmulPrecision) -> MatmulPrecision {
     MatmulPrecision::F32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::MatmulPrecision;
+
+    /// The CPUID bit agrees with the kernel's own reading of it (Linux's `amx_bf16` flag).
+    #[test]
+    fn amx_detection_agrees_with_the_kernel() {
+        let Ok(info) = std::fs::read_to_string("/proc/cpuinfo") else {
+            return; // not Linux: nothing to compare with
+        };
+        let Some(flags) = info.lines().find(|l| l.starts_with("flags")) else {
+            return; // an architecture whose cpuinfo has no flags line
+        };
+        let kernel = flags.split_whitespace().any(|f| f == "amx_bf16");
+        assert_eq!(MatmulPrecision::cpu_has_amx_bf16(), kernel, "{flags}");
+    }
 }

@@ -235,6 +235,13 @@ pub fn fit_and_keep(
              without it); f32 is the faster choice here",
             run.display()
         );
+    } else if t.matmul_precision == MatmulPrecision::Bf16 && MatmulPrecision::cpu_has_amx_bf16() {
+        eprintln!(
+            "{}: warning: matmul_precision = \"bf16\" on an Intel CPU with AMX: the bf16 \
+             products run on AVX512-BF16, not AMX, and were measured 1.3x slower a step than \
+             f32 on such a Xeon (benches/README.md); f32 is likely the faster choice here",
+            run.display()
+        );
     }
     // On a GPU, the weight gradients' sum over the batch is split into parts (split-K): the
     // GPU's matrix-product kernels do not split it themselves. The CPU keeps the plain product.
