@@ -14,6 +14,8 @@
 //!   the same Single MLP step in PyTorch on the same number of threads (on CUDA for the GPU
 //!   backends), back to back with ours: three rounds of 10 steps each side after warm-up, and
 //!   prints the ratios;
+//! - `BRDF_BENCH_MODELS=single_mlp,disney` times only these models (names as in the summary);
+//!   `BRDF_BENCH_RATES=0` skips the gemm and product rates and prints nothing (for `perf`);
 //! - `BRDF_KEEP_MALLOC=0` turns the host-memory policy off (`brdf_neural::host_memory`);
 //! - `BRDF_BENCH_PRECISION=f32,bf16` (default `f32`) also times every step with bf16 matrix
 //!   products ([`brdf_neural::precision`], flex only), with the PyTorch comparison under bf16
@@ -87,6 +89,9 @@ fn configs() -> Vec<(&'static str, ModelConfig)> {
                 out.push((name, ModelConfig::new(kind)));
             }
         }
+    }
+    if let Ok(only) = std::env::var("BRDF_BENCH_MODELS") {
+        out.retain(|(name, _)| only.split(',').any(|m| m.trim() == *name));
     }
     out
 }
@@ -366,6 +371,10 @@ fn bench(cr: &mut Criterion) {
     for backend in backends().into_iter().filter(|b| b.is_gpu()) {
         layer_products(backend, n);
     }
+    if std::env::var("BRDF_BENCH_RATES").is_ok_and(|v| v == "0") {
+        // Steps only (a profile of the steps without the rate measurements).
+        return;
+    }
     let rates = machine_gemm_rates(n);
     let square = rates.square;
     println!(
@@ -386,7 +395,7 @@ fn bench(cr: &mut Criterion) {
             "flex products through burn (allocation included), f32 -> bf16 GFLOP/s: \
              [{n}, 128] x [128, 128] {:.1} -> {:.1} ({:.2}x); weight gradient {:.1} -> {:.1} \
              ({:.2}x); input gradient [{n}, 128] x [128, 128]^T {:.1} -> {:.1} ({:.2}x) \
-             (bf16 native: {})",
+             (bf16 native: {}, on AMX tiles: {})",
             r[0].0,
             r[0].1,
             r[0].1 / r[0].0,
@@ -396,8 +405,19 @@ fn bench(cr: &mut Criterion) {
             r[2].0,
             r[2].1,
             r[2].1 / r[2].0,
-            MatmulPrecision::bf16_native()
+            MatmulPrecision::bf16_native(),
+            MatmulPrecision::bf16_on_amx()
         );
+        if MatmulPrecision::bf16_on_amx() {
+            MatmulPrecision::set_bf16_amx_enabled(false);
+            let r = flex_product_rates(n);
+            MatmulPrecision::set_bf16_amx_enabled(true);
+            println!(
+                "the same bf16 products on the AVX-512 kernel instead of AMX, GFLOP/s: forward \
+                 {:.1}, weight gradient {:.1}, input gradient {:.1}",
+                r[0].1, r[1].1, r[2].1
+            );
+        }
     }
     println!(
         "| backend | precision | split | model | step ms | samples/s | GFLOP/s | fraction of the \

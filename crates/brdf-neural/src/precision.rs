@@ -3,15 +3,17 @@
 //! [`MatmulPrecision::Bf16`] is the CPU counterpart of PyTorch's
 //! `torch.set_float32_matmul_precision("medium")`: the operands of the network's large matrix
 //! products are rounded to bfloat16 (8 significant bits), the products summed in f32; weights,
-//! activations, gradients and Adam stay f32. On CPUs with AVX512-BF16 the products run at twice
-//! the multiply-adds per instruction of f32 (`vdpbf16ps`, in the patched flex backend); elsewhere
-//! the same rounding is emulated, slower than f32. Only the flex CPU backend implements it.
+//! activations, gradients and Adam stay f32. On Intel CPUs with AMX the products run on its tiles
+//! (`tdpbf16ps`), on other CPUs with AVX512-BF16 at twice the multiply-adds per instruction of
+//! f32 (`vdpbf16ps`), both in the patched flex backend; elsewhere the same rounding is emulated,
+//! slower than f32. Only the flex CPU backend implements it.
 //!
 //! The setting is per thread: [`MatmulPrecision::scope`] applies it to the products the calling
 //! thread issues until the returned guard drops, so an evaluation on another thread (or after
 //! the fit) keeps f32; [`MatmulPrecision::f32_scope`] returns to f32 inside a bf16 scope (the
-//! training loop's validation loss, which decides the plateau schedule, is f32). Products that gain nothing (narrow heads such as the 3-channel output,
-//! small or batched products) stay f32.
+//! training loop's validation loss, which decides the plateau schedule, is f32). Products that
+//! gain nothing (narrow heads such as the 3-channel output, small or batched products) stay
+//! f32.
 
 use serde::{Deserialize, Serialize};
 
@@ -60,9 +62,10 @@ impl MatmulPrecision {
     }
 
     /// Whether this CPU has Intel's AMX-BF16 tile unit (Xeons from Sapphire Rapids on; CPUID
-    /// leaf 7, EDX bit 22). Our bf16 kernel does not use it: it runs on AVX512-BF16, and on
-    /// such a Xeon it was measured slower than f32 (`benches/README.md`, "bf16 on an Intel Xeon
-    /// with AMX"), so the trainer warns there.
+    /// leaf 7, EDX bit 22). The flex backend's bf16 products run on it when Linux grants the
+    /// tile registers ([`MatmulPrecision::bf16_on_amx`]); without it they take the AVX512-BF16
+    /// kernel, measured slower than f32 on such a Xeon (`benches/README.md`, "bf16 on an Intel
+    /// Xeon with AMX"), and the trainer warns.
     pub fn cpu_has_amx_bf16() -> bool {
         #[cfg(target_arch = "x86_64")]
         {
@@ -73,6 +76,28 @@ impl MatmulPrecision {
         {
             false
         }
+    }
+
+    /// Whether the bf16 products run on AMX tiles here (the flex backend's AMX kernel: the CPU
+    /// has AMX-BF16 and Linux granted the tile registers; `BURN_FLEX_AMX=0` turns it off).
+    pub fn bf16_on_amx() -> bool {
+        #[cfg(feature = "flex")]
+        {
+            burn_flex::bf16_amx_active()
+        }
+        #[cfg(not(feature = "flex"))]
+        {
+            false
+        }
+    }
+
+    /// Lets the bf16 products use AMX tiles where available (the default) or keeps them on the
+    /// AVX-512 kernel, process-wide: for benchmarks and tests that compare the two.
+    pub fn set_bf16_amx_enabled(enabled: bool) {
+        #[cfg(feature = "flex")]
+        burn_flex::set_bf16_amx_enabled(enabled);
+        #[cfg(not(feature = "flex"))]
+        let _ = enabled;
     }
 
     /// Whether this CPU runs bf16 products natively (otherwise they are emulated, slowly).

@@ -95,17 +95,34 @@ fn max_scaled_error(got: &[f32], want: &[f64], scale: &[f64]) -> f64 {
 
 /// Products large and wide enough to take the bf16 path (m n k >= 2^18, n >= 16, k >= 8), with
 /// tails in every dimension.
-const SHAPES: [(usize, usize, usize); 6] = [
+const SHAPES: [(usize, usize, usize); 7] = [
     (8192, 128, 128),
     (4096, 181, 128),
     (128, 8192, 128),
+    (40, 4097, 20),
     (301, 65, 33),
     (611, 7 * 3, 48),
     (13, 129, 200),
 ];
 
+/// The bf16 kernels this machine can run: AMX tiles (where the CPU and the OS allow them) and
+/// the AVX-512 kernel, or the one it has.
+fn kernels() -> Vec<bool> {
+    if burn_flex::bf16_amx_active() { vec![true, false] } else { vec![false] }
+}
+
 #[test]
 fn bf16_products_equal_the_rounded_operands_product() {
+    for amx in kernels() {
+        // Process-wide; the other tests here are indifferent to which bf16 kernel runs.
+        burn_flex::set_bf16_amx_enabled(amx);
+        assert_eq!(burn_flex::bf16_amx_active(), amx);
+        check_bf16_products(amx);
+    }
+    burn_flex::set_bf16_amx_enabled(true);
+}
+
+fn check_bf16_products(amx: bool) {
     for (si, &(m, k, n)) in SHAPES.iter().enumerate() {
         for layout in [Layout::RowMajor, Layout::LhsTransposed, Layout::RhsTransposed] {
             let mut r = rng(si as u64 * 3 + layout as u64);
@@ -120,14 +137,14 @@ fn bf16_products_equal_the_rounded_operands_product() {
             // f32 sums of k terms: a few ulp of the sum of magnitudes.
             assert!(
                 err < 4e-6 * (k as f64).sqrt().max(1.0),
-                "{m}x{k}x{n} {layout:?}: bf16 error {err:e}"
+                "{m}x{k}x{n} {layout:?} (amx {amx}): bf16 error {err:e}"
             );
             // And the plain f32 product is measurably different (the switch switched).
             let (exact, _) = reference(&a, &b, m, k, n, |x| x as f64);
             let bf_vs_exact = max_scaled_error(&got, &exact, &scale);
             assert!(
                 bf_vs_exact > 1e-4,
-                "{m}x{k}x{n} {layout:?}: bf16 result too close to f32 ({bf_vs_exact:e})"
+                "{m}x{k}x{n} {layout:?} (amx {amx}): bf16 too close to f32 ({bf_vs_exact:e})"
             );
         }
     }
@@ -165,7 +182,7 @@ fn default_precision_is_plain_f32_and_the_guard_restores_it() {
 #[test]
 fn the_emulation_for_cpus_without_bf16_agrees() {
     // Machines without AVX512-BF16 round the operands and call the f32 gemm instead.
-    for &(m, k, n) in &SHAPES[3..] {
+    for &(m, k, n) in &SHAPES[4..] {
         let mut r = rng(m as u64);
         let a: Vec<f32> = (0..m * k).map(|_| r()).collect();
         let b: Vec<f32> = (0..k * n).map(|_| r()).collect();

@@ -235,11 +235,15 @@ pub fn fit_and_keep(
              without it); f32 is the faster choice here",
             run.display()
         );
-    } else if t.matmul_precision == MatmulPrecision::Bf16 && MatmulPrecision::cpu_has_amx_bf16() {
+    } else if t.matmul_precision == MatmulPrecision::Bf16
+        && MatmulPrecision::cpu_has_amx_bf16()
+        && !MatmulPrecision::bf16_on_amx()
+    {
         eprintln!(
-            "{}: warning: matmul_precision = \"bf16\" on an Intel CPU with AMX: the bf16 \
-             products run on AVX512-BF16, not AMX, and were measured 1.3x slower a step than \
-             f32 on such a Xeon (benches/README.md); f32 is likely the faster choice here",
+            "{}: warning: matmul_precision = \"bf16\" on an Intel CPU with AMX, but the AMX \
+             kernel is off (BURN_FLEX_AMX=0, or Linux refused the tile registers): the products \
+             run on AVX512-BF16, measured 1.3x slower a step than f32 on such a Xeon \
+             (benches/README.md); f32 is likely the faster choice here",
             run.display()
         );
     }

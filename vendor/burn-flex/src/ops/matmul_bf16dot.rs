@@ -59,6 +59,29 @@ pub fn bf16_dot_native() -> bool {
     }
 }
 
+/// Whether the bf16 products run on Intel's AMX tiles (patch 7, `matmul_amx`): the CPU has
+/// AMX-TILE and AMX-BF16, Linux granted the tile registers, and `BURN_FLEX_AMX=0` is not set.
+pub fn bf16_amx_active() -> bool {
+    #[cfg(all(target_arch = "x86_64", target_os = "linux"))]
+    {
+        super::matmul_amx::amx_active()
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_os = "linux")))]
+    {
+        false
+    }
+}
+
+/// Lets the bf16 products use AMX tiles where [`bf16_amx_active`] finds them (the default), or
+/// keeps them on the AVX-512 kernel, for the whole process: for tests and benchmarks that
+/// compare the two kernels on one machine.
+pub fn set_bf16_amx_enabled(enabled: bool) {
+    #[cfg(all(target_arch = "x86_64", target_os = "linux"))]
+    super::matmul_amx::set_amx_enabled(enabled);
+    #[cfg(not(all(target_arch = "x86_64", target_os = "linux")))]
+    let _ = enabled;
+}
+
 /// f32 -> bf16 bits, round to nearest even; NaN stays a quiet NaN.
 #[inline]
 pub fn bf16_bits(x: f32) -> u16 {
@@ -91,17 +114,17 @@ unsafe impl Sync for MatRef {}
 impl MatRef {
     /// Start of row i.
     #[inline]
-    unsafe fn row(&self, i: usize) -> *const f32 {
+    pub(crate) unsafe fn row(&self, i: usize) -> *const f32 {
         unsafe { self.ptr.offset(i as isize * self.rs) }
     }
 
     #[inline]
-    unsafe fn at_ptr(&self, i: usize, j: usize) -> *const f32 {
+    pub(crate) unsafe fn at_ptr(&self, i: usize, j: usize) -> *const f32 {
         unsafe { self.ptr.offset(i as isize * self.rs + j as isize * self.cs) }
     }
 
     #[inline]
-    unsafe fn at(&self, i: usize, j: usize) -> f32 {
+    pub(crate) unsafe fn at(&self, i: usize, j: usize) -> f32 {
         unsafe { *self.ptr.offset(i as isize * self.rs + j as isize * self.cs) }
     }
 }
@@ -124,6 +147,11 @@ pub(crate) unsafe fn matmul_bf16dot(
     }
     if k == 0 {
         unsafe { core::ptr::write_bytes(out, 0, m * n) };
+        return;
+    }
+    #[cfg(all(target_arch = "x86_64", target_os = "linux"))]
+    if super::matmul_amx::amx_active() {
+        unsafe { super::matmul_amx::matmul(m, n, k, lhs, rhs, out) };
         return;
     }
     #[cfg(target_arch = "x86_64")]
@@ -202,23 +230,23 @@ pub(crate) unsafe fn emulated(
 
 /// Two floats as one pair of bf16 bits, the first in the low half (the order `vdpbf16ps` pairs).
 #[inline]
-fn pair_bits(x0: f32, x1: f32) -> u32 {
+pub(crate) fn pair_bits(x0: f32, x1: f32) -> u32 {
     bf16_bits(x0) as u32 | ((bf16_bits(x1) as u32) << 16)
 }
 
 #[cfg(target_arch = "x86_64")]
-mod x86 {
+pub(crate) mod x86 {
     use super::{MatRef, Vec, pair_bits, vec};
     use core::arch::x86_64::*;
 
     const MR: usize = 12;
     const NR: usize = 32;
 
-    struct SendPtr<T>(*mut T);
+    pub(crate) struct SendPtr<T>(pub(crate) *mut T);
     unsafe impl<T> Send for SendPtr<T> {}
     unsafe impl<T> Sync for SendPtr<T> {}
     impl<T> SendPtr<T> {
-        fn get(&self) -> *mut T {
+        pub(crate) fn get(&self) -> *mut T {
             self.0
         }
     }
@@ -372,7 +400,7 @@ mod x86 {
 
     /// Row of k floats -> kp pairs.
     #[target_feature(enable = "avx512f,avx512bw,avx512bf16")]
-    unsafe fn convert_row(src: *const f32, k: usize, dst: *mut u32) {
+    pub(crate) unsafe fn convert_row(src: *const f32, k: usize, dst: *mut u32) {
         let mut j = 0;
         unsafe {
             while j + 32 <= k {
@@ -390,26 +418,38 @@ mod x86 {
         }
     }
 
+    /// 16-bit lane order that turns (x_0 .. x_15, y_0 .. y_15) into pairs (x_0, y_0, x_1, ..).
+    #[repr(C, align(64))]
+    pub(crate) struct LaneOrder(pub(crate) [u16; 32]);
+
+    pub(crate) static PAIR_ORDER: LaneOrder = {
+        let mut o = [0u16; 32];
+        let mut r = 0;
+        while r < 16 {
+            o[2 * r] = r as u16;
+            o[2 * r + 1] = 16 + r as u16;
+            r += 1;
+        }
+        LaneOrder(o)
+    };
+
     /// Interleaves rows r0 and r1 (r1 may be null for zero) of 16 floats into 16 pairs at dst.
     #[target_feature(enable = "avx512f,avx512bw,avx512bf16")]
     #[inline]
-    unsafe fn interleave16(r0: *const f32, r1: *const f32, dst: *mut u32) {
+    pub(crate) unsafe fn interleave16(r0: *const f32, r1: *const f32, dst: *mut u32) {
         unsafe {
-            let x: __m256i = core::mem::transmute(_mm512_cvtneps_pbh(_mm512_loadu_ps(r0)));
-            let xi = _mm512_cvtepu16_epi32(x);
-            let pairs = if r1.is_null() {
-                xi
-            } else {
-                let y: __m256i = core::mem::transmute(_mm512_cvtneps_pbh(_mm512_loadu_ps(r1)));
-                _mm512_or_si512(xi, _mm512_slli_epi32::<16>(_mm512_cvtepu16_epi32(y)))
-            };
-            _mm512_storeu_si512(dst as *mut _, pairs);
+            // Both rows in one conversion (r0 in the low 16 lanes, r1 or zero in the high),
+            // then one permute into pairs (r0[c], r1[c]).
+            let y = if r1.is_null() { _mm512_setzero_ps() } else { _mm512_loadu_ps(r1) };
+            let xy: __m512i = core::mem::transmute(_mm512_cvtne2ps_pbh(y, _mm512_loadu_ps(r0)));
+            let order = _mm512_loadu_si512(PAIR_ORDER.0.as_ptr() as *const _);
+            _mm512_storeu_si512(dst as *mut _, _mm512_permutexvar_epi16(order, xy));
         }
     }
 
     /// Rows r0 and r0 + 1 (zero at or past `k_end`) of the right operand as one pair row of
     /// every panel: column c at `dst + (c / 32) * panel_stride + c % 32`, panel_stride = kp * 32.
-    unsafe fn pack_b_pair(
+    pub(crate) unsafe fn pack_b_pair(
         n: usize,
         r0: usize,
         k_end: usize,

@@ -111,6 +111,8 @@ mod int;
 pub mod interpolate;
 pub mod mask;
 pub mod matmul;
+#[cfg(all(feature = "std", target_arch = "x86_64", target_os = "linux"))]
+pub mod matmul_amx;
 #[cfg(feature = "std")]
 pub mod matmul_bf16dot;
 pub mod matmul_split_k;
