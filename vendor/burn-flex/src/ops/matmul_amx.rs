@@ -195,21 +195,43 @@ unsafe fn block(
     }
 }
 
-/// out (m x n, row-major) = lhs (m x k) * rhs (k x n) with bf16 operands on AMX tiles.
+/// out (m x n, row-major) = lhs (m x k) * rhs (k x n) [+ bias, one value per column] with bf16
+/// operands on AMX tiles. The bias is added to each 32 x 32 block as it leaves the tiles (patch
+/// 8), the same f32 addition as a separate pass.
 ///
 /// # Safety
-/// As [`super::matmul_bf16dot::matmul_bf16dot`]; [`amx_active`] must be true; m, n, k > 0.
-pub(crate) unsafe fn matmul(m: usize, n: usize, k: usize, lhs: MatRef, rhs: MatRef, out: *mut f32) {
+/// As [`super::matmul_bf16dot::matmul_bf16dot`]; [`amx_active`] must be true; m, n, k > 0;
+/// `bias`, if any, holds n values.
+pub(crate) unsafe fn matmul(
+    m: usize,
+    n: usize,
+    k: usize,
+    lhs: MatRef,
+    rhs: MatRef,
+    out: *mut f32,
+    bias: Option<&[f32]>,
+) {
     #[cfg(feature = "rayon")]
     if k >= 2048 && m * n <= k * 16 {
         unsafe { split_k(m, n, k, lhs, rhs, out) };
+        if let Some(b) = bias {
+            unsafe { super::matmul_bf16dot::add_bias_rows(m, n, out, b) };
+        }
         return;
     }
-    unsafe { by_rows(m, n, k, lhs, rhs, out) }
+    unsafe { by_rows(m, n, k, lhs, rhs, out, bias) }
 }
 
 /// Blocks of 32 rows in parallel, the whole k of a block in one tile loop.
-unsafe fn by_rows(m: usize, n: usize, k: usize, lhs: MatRef, rhs: MatRef, out: *mut f32) {
+unsafe fn by_rows(
+    m: usize,
+    n: usize,
+    k: usize,
+    lhs: MatRef,
+    rhs: MatRef,
+    out: *mut f32,
+    bias: Option<&[f32]>,
+) {
     let kp = k.div_ceil(2);
     let kpp = kp.next_multiple_of(KT);
     let panels = n.div_ceil(NB);
@@ -237,12 +259,23 @@ unsafe fn by_rows(m: usize, n: usize, k: usize, lhs: MatRef, rhs: MatRef, out: *
                 let a = apack.as_ptr();
                 if rows == MB && cols == NB {
                     unsafe { block(a, kpp * 4, b, kpp / KT, c, n * 4, false) };
+                    if let Some(bias) = bias {
+                        unsafe { add_bias_block(c, n, bias.as_ptr().add(j * NB)) };
+                    }
                 } else {
                     unsafe { block(a, kpp * 4, b, kpp / KT, edge.as_mut_ptr(), NB * 4, false) };
                     for r in 0..rows {
                         let src = &edge[r * NB..r * NB + cols];
                         let dst = unsafe { core::slice::from_raw_parts_mut(c.add(r * n), cols) };
-                        dst.copy_from_slice(src);
+                        match bias {
+                            Some(bias) => {
+                                let bias = &bias[j * NB..j * NB + cols];
+                                for ((d, s), b) in dst.iter_mut().zip(src).zip(bias) {
+                                    *d = s + b;
+                                }
+                            }
+                            None => dst.copy_from_slice(src),
+                        }
                     }
                 }
             }
@@ -258,6 +291,22 @@ unsafe fn by_rows(m: usize, n: usize, k: usize, lhs: MatRef, rhs: MatRef, out: *
     let mut scratch = (Vec::new(), Vec::new());
     for t in 0..tasks {
         run(t, &mut scratch);
+    }
+}
+
+/// Adds 32 bias values (`bias`) to each of the 32 rows of a block just stored at `c` (row
+/// stride `ldc` floats), while the block is still in L1.
+#[target_feature(enable = "avx512f")]
+#[inline]
+unsafe fn add_bias_block(c: *mut f32, ldc: usize, bias: *const f32) {
+    unsafe {
+        let b0 = _mm512_loadu_ps(bias);
+        let b1 = _mm512_loadu_ps(bias.add(16));
+        for r in 0..MB {
+            let row = c.add(r * ldc);
+            _mm512_storeu_ps(row, _mm512_add_ps(_mm512_loadu_ps(row), b0));
+            _mm512_storeu_ps(row.add(16), _mm512_add_ps(_mm512_loadu_ps(row.add(16)), b1));
+        }
     }
 }
 

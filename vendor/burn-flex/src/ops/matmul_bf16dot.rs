@@ -129,11 +129,14 @@ impl MatRef {
     }
 }
 
-/// out (m x n, row-major, contiguous) = lhs (m x k) * rhs (k x n) with bf16 operands. Every
-/// element of `out` is written (it may start uninitialised).
+/// out (m x n, row-major, contiguous) = lhs (m x k) * rhs (k x n) [+ bias] with bf16 operands.
+/// Every element of `out` is written (it may start uninitialised). The bias (n values, one per
+/// column, added in f32 after the sum) goes into the AMX kernel's store; the other kernels add
+/// it in one pass afterwards.
 ///
 /// # Safety
-/// `lhs` and `rhs` must address valid m x k and k x n matrices, `out` m * n writable floats.
+/// `lhs` and `rhs` must address valid m x k and k x n matrices, `out` m * n writable floats;
+/// `bias`, if any, holds n values.
 pub(crate) unsafe fn matmul_bf16dot(
     m: usize,
     n: usize,
@@ -141,25 +144,59 @@ pub(crate) unsafe fn matmul_bf16dot(
     lhs: MatRef,
     rhs: MatRef,
     out: *mut f32,
+    bias: Option<&[f32]>,
 ) {
     if m == 0 || n == 0 {
         return;
     }
     if k == 0 {
         unsafe { core::ptr::write_bytes(out, 0, m * n) };
+    } else {
+        #[cfg(all(target_arch = "x86_64", target_os = "linux"))]
+        if super::matmul_amx::amx_active() {
+            unsafe { super::matmul_amx::matmul(m, n, k, lhs, rhs, out, bias) };
+            return;
+        }
+        #[cfg(target_arch = "x86_64")]
+        let native = bf16_dot_native();
+        #[cfg(not(target_arch = "x86_64"))]
+        let native = false;
+        if native {
+            #[cfg(target_arch = "x86_64")]
+            unsafe {
+                x86::matmul(m, n, k, lhs, rhs, out)
+            };
+        } else {
+            unsafe { emulated(m, n, k, lhs, rhs, core::slice::from_raw_parts_mut(out, m * n)) };
+        }
+    }
+    if let Some(b) = bias {
+        unsafe { add_bias_rows(m, n, out, b) };
+    }
+}
+
+/// Adds `bias` (n values) to every row of the m x n row-major matrix at `out`, rows in
+/// parallel: the same f32 additions as burn's broadcast add.
+///
+/// # Safety
+/// `out` addresses m * n floats that no one else touches meanwhile; `bias.len() == n`.
+pub(crate) unsafe fn add_bias_rows(m: usize, n: usize, out: *mut f32, bias: &[f32]) {
+    let out = unsafe { core::slice::from_raw_parts_mut(out, m * n) };
+    let add = |rows: &mut [f32]| {
+        for row in rows.chunks_exact_mut(n) {
+            for (x, b) in row.iter_mut().zip(bias) {
+                *x += b;
+            }
+        }
+    };
+    #[cfg(feature = "rayon")]
+    if m * n >= 1 << 17 {
+        use rayon::prelude::*;
+        let rows = (1usize << 14).div_ceil(n).max(1);
+        out.par_chunks_mut(rows * n).for_each(add);
         return;
     }
-    #[cfg(all(target_arch = "x86_64", target_os = "linux"))]
-    if super::matmul_amx::amx_active() {
-        unsafe { super::matmul_amx::matmul(m, n, k, lhs, rhs, out) };
-        return;
-    }
-    #[cfg(target_arch = "x86_64")]
-    if bf16_dot_native() {
-        unsafe { x86::matmul(m, n, k, lhs, rhs, out) };
-        return;
-    }
-    unsafe { emulated(m, n, k, lhs, rhs, core::slice::from_raw_parts_mut(out, m * n)) };
+    add(out);
 }
 
 /// The emulated path on row-major operands (what CPUs without AVX512-BF16 run), public so

@@ -109,6 +109,7 @@ pub mod gather_scatter;
 pub mod grid_sample;
 mod int;
 pub mod interpolate;
+pub mod linear;
 pub mod mask;
 pub mod matmul;
 #[cfg(all(feature = "std", target_arch = "x86_64", target_os = "linux"))]

@@ -1,0 +1,130 @@
+//! Linear layers with the bias added in the matrix product's store (vendor/burn-flex patch 8,
+//! reached through vendor/burn-dispatch's forwarding of `linear`).
+//!
+//! A layer's value and its gradients must be those of the unfused form, the product followed
+//! by a broadcast add, to the bit: in f32 (the gemm in blocks of rows) and in bf16 (the AMX
+//! kernel's block store, and the AVX-512 kernel or the emulation with the add after), for
+//! shapes with tails in every dimension, outputs narrower than the fused path takes, and inputs
+//! with leading dimensions.
+#![cfg(feature = "flex")]
+
+use brdf_neural::device::{self, Backend};
+use brdf_neural::precision::MatmulPrecision;
+use burn::tensor::module::linear;
+use burn::tensor::{Tensor, TensorData};
+
+/// Deterministic values in [-1, 1).
+fn values(n: usize, seed: u64) -> Vec<f32> {
+    let mut s = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
+    (0..n)
+        .map(|_| {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 23) as f32 - 1.0
+        })
+        .collect()
+}
+
+/// (rows, d_in, d_out): rows past one block of the f32 path (1,024 rows at 128 outputs) with a
+/// tail, rows and columns off the AMX kernel's 32 x 32 blocks, an odd inner dimension, the
+/// first layer's and the skip layer's inner dimensions, and a 3-channel head (not fused).
+const SHAPES: [(usize, usize, usize); 7] = [
+    (2_085, 128, 128),
+    (77, 33, 19),
+    (300, 188, 128),
+    (1_030, 40, 48),
+    (64, 7, 16),
+    (513, 64, 3),
+    (1, 5, 200),
+];
+
+fn bits(t: Tensor<2>) -> Vec<u32> {
+    t.into_data().try_to_vec::<f32>().unwrap().iter().map(|v| v.to_bits()).collect()
+}
+
+/// Fails with the first element that differs (and how many do).
+fn assert_same_bits(got: &[u32], want: &[u32], what: &str) {
+    assert_eq!(got.len(), want.len(), "{what}: length");
+    let differ = got.iter().zip(want).filter(|(g, w)| g != w).count();
+    if let Some(i) = got.iter().zip(want).position(|(g, w)| g != w) {
+        let (g, w) = (f32::from_bits(got[i]), f32::from_bits(want[i]));
+        panic!("{what}: {differ} of {} elements differ, first [{i}]: {g} vs {w}", got.len());
+    }
+}
+
+/// The layer through `linear` and as product plus broadcast add, as bit patterns.
+fn fused_and_plain(m: usize, k: usize, n: usize, seed: u64) -> (Vec<u32>, Vec<u32>) {
+    let d = device::cpu();
+    let x = Tensor::<2>::from_data(TensorData::new(values(m * k, seed), [m, k]), &d);
+    let w = Tensor::<2>::from_data(TensorData::new(values(k * n, seed + 1), [k, n]), &d);
+    let b = Tensor::<1>::from_data(TensorData::new(values(n, seed + 2), [n]), &d);
+    let fused = linear(x.clone(), w.clone(), Some(b.clone()));
+    let plain = x.matmul(w) + b.unsqueeze::<2>();
+    (bits(fused), bits(plain))
+}
+
+#[test]
+fn f32_linear_layers_equal_the_product_plus_the_bias_to_the_bit() {
+    for (i, &(m, k, n)) in SHAPES.iter().enumerate() {
+        let (fused, plain) = fused_and_plain(m, k, n, 10 * i as u64);
+        assert_same_bits(&fused, &plain, &format!("[{m}, {k}] x [{k}, {n}] + b"));
+    }
+}
+
+#[test]
+fn bf16_linear_layers_equal_the_product_plus_the_bias_to_the_bit() {
+    let kernels = if burn_flex::bf16_amx_active() { vec![true, false] } else { vec![false] };
+    for amx in kernels {
+        // Process-wide; the other tests here run f32, which no bf16 kernel touches.
+        burn_flex::set_bf16_amx_enabled(amx);
+        let _g = MatmulPrecision::Bf16.scope(Backend::Flex).unwrap();
+        for (i, &(m, k, n)) in SHAPES.iter().enumerate() {
+            let (fused, plain) = fused_and_plain(m, k, n, 100 + 10 * i as u64);
+            let what = format!("bf16 (AMX: {amx}) [{m}, {k}] x [{k}, {n}] + b");
+            assert_same_bits(&fused, &plain, &what);
+        }
+    }
+    burn_flex::set_bf16_amx_enabled(true);
+}
+
+#[test]
+fn linear_layer_gradients_equal_the_unfused_gradients_to_the_bit() {
+    let d = device::cpu_training();
+    let (m, k, n) = (1_100, 36, 64);
+    let r = Tensor::<2>::from_data(TensorData::new(values(m * n, 7), [m, n]), &d);
+    let run = |fused: bool| {
+        let x =
+            Tensor::<2>::from_data(TensorData::new(values(m * k, 1), [m, k]), &d).require_grad();
+        let w =
+            Tensor::<2>::from_data(TensorData::new(values(k * n, 2), [k, n]), &d).require_grad();
+        let b = Tensor::<1>::from_data(TensorData::new(values(n, 3), [n]), &d).require_grad();
+        let y = if fused {
+            linear(x.clone(), w.clone(), Some(b.clone()))
+        } else {
+            x.clone().matmul(w.clone()) + b.clone().unsqueeze::<2>()
+        };
+        let grads = (y.clone() * r.clone()).sum().backward();
+        let g = |t: Tensor<2>| bits(t.grad(&grads).unwrap());
+        let gb = b.grad(&grads).unwrap().into_data().try_to_vec::<f32>().unwrap();
+        (bits(y), g(x), g(w), gb.iter().map(|v| v.to_bits()).collect::<Vec<_>>())
+    };
+    let (fused, plain) = (run(true), run(false));
+    assert_same_bits(&fused.0, &plain.0, "values");
+    assert_same_bits(&fused.1, &plain.1, "dL/dx");
+    assert_same_bits(&fused.2, &plain.2, "dL/dW");
+    assert_same_bits(&fused.3, &plain.3, "dL/db");
+}
+
+#[test]
+fn leading_dimensions_fold_into_the_rows() {
+    let d = device::cpu();
+    let (k, n) = (24, 32);
+    let x = Tensor::<3>::from_data(TensorData::new(values(3 * 50 * k, 5), [3, 50, k]), &d);
+    let w = Tensor::<2>::from_data(TensorData::new(values(k * n, 6), [k, n]), &d);
+    let b = Tensor::<1>::from_data(TensorData::new(values(n, 8), [n]), &d);
+    let y = linear(x.clone(), w.clone(), Some(b.clone()));
+    assert_eq!(y.dims(), [3, 50, n]);
+    let rows = linear(x.reshape([150, k]), w, Some(b));
+    assert_same_bits(&bits(y.reshape([150, n])), &bits(rows), "[3, 50, k] against [150, k]");
+}
