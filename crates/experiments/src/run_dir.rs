@@ -124,9 +124,10 @@ impl RunDir {
         self.weights().is_file() && self.metrics().is_file()
     }
 
-    /// Whether the run has been evaluated (test metrics written).
+    /// Whether the run has been evaluated (test metrics written, in both protocols: a run
+    /// evaluated before the paper's protocol existed is evaluated again, not trained again).
     pub fn is_evaluated(&self) -> bool {
-        RunMetrics::read(&self.metrics()).is_ok_and(|m| m.test.is_some())
+        RunMetrics::read(&self.metrics()).is_ok_and(|m| m.test.is_some_and(|t| t.paper.is_some()))
     }
 
     /// Reads the run's configuration.

@@ -19,6 +19,14 @@
 //! image in all three comparisons of a test image (a noise-free image can be all black in the
 //! mask, where FLIP's range is undefined).
 //!
+//! **Two protocols.** Everything above is ours: the object mask, against the observations,
+//! beside the noise ceiling. The paper's Table 1 scores differently, and every run is scored
+//! that way too ([`ImageScores::paper`], [`whole_frame`]): the whole frame, background
+//! included, against the noise-free render (a capture has none: its observation with the
+//! background set to 0). The background is exactly 0 in the render and that reference, so the
+//! whole frame's PSNR exceeds the masked one by 10 log10(frame pixels / object pixels) when
+//! the scores are against the same reference, and an exact model scores +inf dB.
+//!
 //! Written into the run directory when images are on:
 //!
 //! ```text
@@ -87,6 +95,10 @@ impl ImageMetrics {
 pub struct ImageScores {
     /// The model against the observed (noisy) test images.
     pub model: ImageMetrics,
+    /// The paper's protocol: the model against the noise-free test images (captured scenes:
+    /// the observations with the background set to 0) over the whole frame
+    /// ([`whole_frame`]).
+    pub paper: Option<ImageMetrics>,
     /// The model against the noise-free test images (semi-synthetic scenes).
     pub clean: Option<ImageMetrics>,
     /// The noise ceiling: the noise-free images against the observed ones (semi-synthetic
@@ -96,6 +108,8 @@ pub struct ImageScores {
     pub images: usize,
     /// Pixels scored over all test images (the masks' sizes summed).
     pub pixels: usize,
+    /// Pixels of the whole frames of all test images (the paper's protocol).
+    pub frame_pixels: usize,
 }
 
 /// Writes a linear RGB image as an EXR file atomically.
@@ -163,6 +177,40 @@ pub fn score(
     Ok((m, flip))
 }
 
+/// The paper's protocol on one test image: `test` against `reference` over the whole frame,
+/// background included (PSNR and DSSIM on sRGB clamped to [0, 1], data range 1; HDR-FLIP the
+/// mean of `flip`'s map over every pixel). `flip` is HDR-FLIP of the same pair, computed with
+/// the exposure range of the reference's object pixels: a whole frame whose background (most
+/// of it) is black has a zero median luminance and so no exposure range of its own. `lpips`
+/// is the pair's LPIPS, which LPIPS already computes on the whole frame (the background is 0 in
+/// both images here, as in the masked protocol's input).
+pub fn whole_frame(
+    test: &Image,
+    reference: &Image,
+    flip: &metrics::flip::FlipResult,
+    lpips: Option<f64>,
+) -> Result<ImageMetrics> {
+    let map = &flip.map;
+    Ok(ImageMetrics {
+        psnr: metrics::psnr_linear(test, reference, None)?,
+        dssim: metrics::dssim_linear(test, reference, None)?,
+        flip: map.iter().map(|&v| v as f64).sum::<f64>() / map.len().max(1) as f64,
+        lpips,
+    })
+}
+
+/// The observation of a captured scene as the paper's protocol's reference: the pixels outside
+/// the object mask set to 0, as they are in every render (captures have no noise-free image).
+fn background_removed(observed: &Image, mask: &[bool]) -> Result<Image> {
+    let d: Vec<f32> = observed
+        .data()
+        .chunks_exact(3)
+        .zip(mask)
+        .flat_map(|(c, &inside)| if inside { [c[0], c[1], c[2]] } else { [0.0; 3] })
+        .collect();
+    Ok(Image::new(observed.width(), observed.height(), d)?)
+}
+
 /// What [`render_and_score`] needs besides the scene and the prediction.
 pub struct RenderOptions<'a> {
     /// The run directory (images are written below it).
@@ -208,17 +256,30 @@ pub fn render_and_score(
         let test = to_image(w, h, &img)?;
         let observed = to_image(w, h, &dataset.observed_image(vi, li)?)?;
         let (model, flip) = score(&test, &observed, &mask, opts.lpips, None)?;
-        let mut scores = PairScores { model, clean: None, ceiling: None };
+        // Every comparison of a test image shares the observed image's FLIP exposures (a
+        // noise-free image can be black where every lit pixel faces away).
+        let exposures = Some((flip.start_exposure, flip.stop_exposure));
+        let mut scores = PairScores { model, clean: None, ceiling: None, paper: None };
         if let Some(noise_free) = dataset.clean_image(vi, li)? {
-            // The three scores of a test image share the observed image's FLIP exposures (a
-            // noise-free image can be black where every lit pixel faces away).
-            let exposures = Some((flip.start_exposure, flip.stop_exposure));
             let noise_free = to_image(w, h, &noise_free)?;
-            scores.clean = Some(score(&test, &noise_free, &mask, opts.lpips, exposures)?.0);
+            let (clean, clean_flip) = score(&test, &noise_free, &mask, opts.lpips, exposures)?;
+            // Both images are 0 outside the mask: the masked LPIPS is the whole frame's.
+            scores.paper = Some(whole_frame(&test, &noise_free, &clean_flip, clean.lpips)?);
+            scores.clean = Some(clean);
             if !opts.skip_ceiling {
                 scores.ceiling =
                     Some(score(&noise_free, &observed, &mask, opts.lpips, exposures)?.0);
             }
+        } else {
+            let reference = background_removed(&observed, &mask)?;
+            let config = metrics::flip::FlipConfig {
+                start_exposure: exposures.map(|e| e.0),
+                stop_exposure: exposures.map(|e| e.1),
+                ..Default::default()
+            };
+            let f = metrics::hdr_flip_with(&test, &reference, None, &config)?;
+            // The masked LPIPS blacks out both backgrounds: it is the whole frame's here.
+            scores.paper = Some(whole_frame(&test, &reference, &f, scores.model.lpips)?);
         }
         if let Some(out) = &out {
             let stem = format!("view{vi:03}_light{li:03}");
@@ -241,8 +302,12 @@ pub fn render_and_score(
     };
     bar.finish_and_clear();
     let (mut model, mut clean, mut ceiling) = (ImageMetrics::default(), None, None);
+    let mut paper: Option<ImageMetrics> = None;
     for s in &per_pair {
         model.add(&s.model);
+        if let Some(p) = &s.paper {
+            paper.get_or_insert_with(ImageMetrics::default).add(p);
+        }
         if let Some(c) = &s.clean {
             clean.get_or_insert_with(ImageMetrics::default).add(c);
         }
@@ -262,6 +327,8 @@ pub fn render_and_score(
     let pixels = t.pairs.iter().map(|&(vi, _)| dataset.geometry.views[vi].pixels.len()).sum();
     Ok(ImageScores {
         model: model.divided(n),
+        paper: paper.map(|p| p.divided(n)),
+        frame_pixels: n * w * h,
         clean: clean.map(|c| c.divided(n)),
         ceiling: ceiling.map(|c| c.divided(n)),
         images: n,
@@ -274,6 +341,7 @@ struct PairScores {
     model: ImageMetrics,
     clean: Option<ImageMetrics>,
     ceiling: Option<ImageMetrics>,
+    paper: Option<ImageMetrics>,
 }
 
 /// The mean PSNR of the renders of `f` (one BRDF value per record of `data`) against the

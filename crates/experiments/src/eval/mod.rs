@@ -1,8 +1,11 @@
 //! `eval`: renders the test images of a finished run and computes every metric of the paper
 //! (spec section 7).
 //!
-//! * [`images`]: test renders, PSNR / DSSIM / HDR-FLIP / LPIPS on the object mask, FLIP error
-//!   maps and the additive models' diffuse / specular / albedo figures.
+//! * [`images`]: test renders, PSNR / DSSIM / HDR-FLIP / LPIPS in both protocols (ours: the
+//!   object mask against the observed images; the paper's: the whole frame against the
+//!   noise-free renders), FLIP error maps and the additive models' diffuse / specular / albedo
+//!   figures.
+//! * [`metric_settings`]: the exact settings of each protocol, written beside the scores.
 //! * [`analyses`]: energy conservation and the reciprocity RMSE on the test records.
 //! * [`predict`](mod@predict): the model on CPU records, and as a [`metrics::BatchBrdf`].
 //! * [`probe`]: the model on the BRDF plots' fixed directions (lit sphere, slices, albedo
@@ -57,7 +60,8 @@ pub struct CurvePoint {
 /// Test metrics of a run (spec 7), raw values (not table-scaled).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct TestMetrics {
-    /// Mean PSNR over the test images (dB, sRGB clamped, object mask).
+    /// Mean PSNR over the test images (dB, sRGB clamped, object mask): our protocol, as are
+    /// every score up to `lpips` and `settings`.
     pub psnr: f64,
     /// Mean DSSIM over the test images.
     pub dssim: f64,
@@ -70,6 +74,10 @@ pub struct TestMetrics {
     /// best any model can score (semi-synthetic scenes only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ceiling: Option<ImageMetrics>,
+    /// The paper's protocol: the whole frame against the noise-free renders, with its
+    /// settings (absent in runs evaluated before it was added; the sweep re-evaluates them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub paper: Option<metric_settings::PaperProtocol>,
     /// Mean LPIPS over the test images (absent without weights).
     #[serde(default)]
     pub lpips: Option<f64>,
@@ -267,6 +275,14 @@ pub fn eval_fitted(
         psnr: scores.model.psnr,
         dssim: scores.model.dssim,
         flip: scores.model.flip,
+        paper: scores.paper.map(|p| metric_settings::PaperProtocol {
+            scores: p,
+            settings: metric_settings::PaperSettings::current(
+                scores.images,
+                scores.frame_pixels,
+                scores.clean.is_some(),
+            ),
+        }),
         clean: scores.clean,
         ceiling: scores.ceiling,
         lpips: scores.model.lpips,
