@@ -8,8 +8,11 @@
 //!   deltas.
 //! * [`table`], [`rank`]: the table model and its highlighting (best / second / third,
 //!   improvements); [`markdown`] and [`latex`] render it.
-//! * [`tables`]: Table 1 (with the noise ceiling and against the noise-free renders),
-//!   reciprocity RMSE, energy conservation, per-object tables.
+//! * [`tables`]: Table 1 in both protocols ([`Protocol`]: ours, with the noise ceiling, and
+//!   the paper's), against the noise-free renders, reciprocity RMSE, energy conservation,
+//!   per-object tables.
+//! * [`paper`]: the paper's published Table 1 as data, ours beside it cell by cell under its
+//!   protocol, the ranking agreement (Kendall's τ-b) and a checklist of its findings.
 //! * [`runtime`]: run time against accuracy (seconds to each model's plateau).
 //! * [`deltas`]: the ablations (NOL, reciprocity options, angle parametrization, NeRFactor
 //!   changes) as differences to the baseline.
@@ -34,6 +37,7 @@ pub mod grid;
 pub mod html;
 pub mod latex;
 pub mod markdown;
+pub mod paper;
 pub mod plot;
 pub mod rank;
 pub mod raster;
@@ -55,5 +59,6 @@ pub use record::{Dataset, Direction, MetricKind, RunOptions, RunRecord};
 pub use runtime::time_to_accuracy;
 pub use table::{Cell, Column, ColumnGroup, Marking, Row, Table};
 pub use tables::{
-    CEILING_LABEL, energy_table, per_object_table, reciprocity_table, table1, table1_noise_free,
+    CEILING_LABEL, Protocol, energy_table, per_object_table, reciprocity_table, table1,
+    table1_noise_free, table1_paper,
 };

@@ -3,8 +3,8 @@
 //!
 //! Every builder takes all records, keeps each run's last evaluation
 //! ([`final_records`]), averages per object then over objects ([`average`]) and states the
-//! data and the profile in its caption. Column groups are the data sets present, in the order
-//! MERL-derived (NBRDF), DiLiGenT-MV, DiLiGenT, others.
+//! data, the profile and, for image metrics, the [`Protocol`] in its caption. Column groups
+//! are the data sets present, in the order MERL-derived (NBRDF), DiLiGenT-MV, DiLiGenT, others.
 
 use super::average::{average, datasets, final_records, objects, per_object};
 use super::record::{Dataset, MetricKind, RunOptions, RunRecord};
@@ -13,11 +13,59 @@ use brdf_neural::{ModelKind, Reciprocity};
 use metrics::aggregate::{PerObjectMean, Score};
 use std::collections::BTreeMap;
 
+/// How the image metrics of a table were computed. Every run is scored both ways; each
+/// table's caption names its protocol.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Protocol {
+    /// Ours: the object's pixels only, against the observed (noisy) test images, beside the
+    /// data's noise ceiling.
+    Ours,
+    /// The paper's: the whole frame, background included, against the noise-free test renders
+    /// (a capture has none: its observations with the background set to 0).
+    Paper,
+}
+
+impl Protocol {
+    /// The phrase every caption of the protocol starts with.
+    pub fn caption(self) -> &'static str {
+        match self {
+            Protocol::Ours => {
+                "Our protocol: the object mask, against the observed (noisy) test images, \
+                 beside the noise ceiling."
+            }
+            Protocol::Paper => {
+                "The paper's protocol: the whole frame, background included, against the \
+                 noise-free test renders (captures: the observations with the background set \
+                 to 0); sRGB clamped to [0, 1], data range 1."
+            }
+        }
+    }
+
+    /// A short name for file names and headings ("ours", "paper").
+    pub fn name(self) -> &'static str {
+        match self {
+            Protocol::Ours => "ours",
+            Protocol::Paper => "paper",
+        }
+    }
+}
+
 /// "`title` Data: `labels`. Profile: `profile`."
+/// Real captures among `data` add a sentence saying which columns they are.
 pub(crate) fn caption(title: &str, data: &[Dataset], profile: &str) -> String {
     let labels: Vec<&str> = data.iter().map(Dataset::label).collect();
-    let data = if labels.is_empty() { "none".to_string() } else { labels.join(", ") };
-    format!("{title} Data: {data}. Profile: {profile}.")
+    let real: Vec<&str> =
+        data.iter().filter(|d| !d.has_brdf_ground_truth()).map(Dataset::label).collect();
+    let list = if labels.is_empty() { "none".to_string() } else { labels.join(", ") };
+    let mut s = format!("{title} Data: {list}. Profile: {profile}.");
+    if !real.is_empty() {
+        s += &format!(
+            " Real captures (the real-world columns): {}; photographs, so no ground-truth \
+             BRDF (no RMSE∛) and no noise-free image (no noise ceiling).",
+            real.join(", ")
+        );
+    }
+    s
 }
 
 /// The image metrics of `dataset`: PSNR, DSSIM, LPIPS, FLIP, and RMSE∛ where a ground-truth
@@ -125,8 +173,9 @@ pub fn table1(records: &[RunRecord], ceiling: &[RunRecord], profile: &str) -> Ta
     });
     Table {
         caption: caption(
-            "Table 1: image metrics of the models with default options against the observed \
-             (noisy) test images, averaged per object, then over objects; DSSIM, LPIPS, FLIP \
+            "Table 1. Our protocol: the object mask, against the observed (noisy) test images, \
+             beside the noise ceiling. Image metrics of the models with default options, \
+             averaged per object, then over objects; DSSIM, LPIPS, FLIP \
              and RMSE∛ ×100 (RMSE∛ only where a ground-truth BRDF exists). The ground truth's \
              own noise-free renders score the noise ceiling, the best any model can; \
              'below ceiling' is its PSNR minus the model's; time is the training wall time \
@@ -143,8 +192,8 @@ pub fn table1(records: &[RunRecord], ceiling: &[RunRecord], profile: &str) -> Ta
 }
 
 /// Table 1's models scored against the noise-free test renders instead of the observed
-/// images (semi-synthetic data only: the records carry the metrics against the noise-free
-/// renders). The ground truth would score ∞ dB here and is left out.
+/// images, on the object mask (semi-synthetic data only: the records carry the metrics against
+/// the noise-free renders). The ground truth would score ∞ dB here and is left out.
 pub fn table1_noise_free(records: &[RunRecord], profile: &str) -> Table {
     let last = final_records(records);
     let data = datasets(&last);
@@ -152,10 +201,39 @@ pub fn table1_noise_free(records: &[RunRecord], profile: &str) -> Table {
         model_table(&last, &[], &data, |_| metric_columns(MetricKind::IMAGE.to_vec()));
     Table {
         caption: caption(
-            "Table 1 against the noise-free test renders: the models' renders scored against \
-             the ground truth's noise-free images instead of the noisy observations (the \
-             noise removed), averaged per object, then over objects; DSSIM, LPIPS and FLIP \
-             ×100. The ground truth scores ∞ dB here.",
+            "Table 1 against the noise-free test renders, on the object mask (our protocol's \
+             pixels, the paper's reference): the models' renders scored against the ground \
+             truth's noise-free images instead of the noisy observations, averaged per \
+             object, then over objects; DSSIM, LPIPS and FLIP ×100. The ground truth scores \
+             ∞ dB here.",
+            &data,
+            profile,
+        ),
+        stub_header: "Model".into(),
+        groups,
+        rows,
+        marking: Marking::RankColumns,
+        notes: vec![],
+    }
+}
+
+/// Table 1 under the paper's protocol ([`Protocol::Paper`]): `records` carry the scores of
+/// the whole frame against the noise-free renders (and RMSE∛, which no protocol changes).
+/// Per data set PSNR↑, DSSIM↓, LPIPS↓, FLIP↓ and, where a ground-truth BRDF exists, RMSE∛↓,
+/// as the paper's Table 1; no noise ceiling (an exact model scores ∞ dB here) and no time.
+pub fn table1_paper(records: &[RunRecord], profile: &str) -> Table {
+    let last = final_records(records);
+    let data = datasets(&last);
+    let (groups, rows) = model_table(&last, &[], &data, |d| metric_columns(image_metrics(d)));
+    Table {
+        caption: caption(
+            &format!(
+                "Table 1. {} Image metrics of the models with default options, averaged per \
+                 image, then per object, then over objects; DSSIM, LPIPS, FLIP and RMSE∛ ×100 \
+                 (RMSE∛, in BRDF space, is the same in both protocols). An exact model scores \
+                 ∞ dB here.",
+                Protocol::Paper.caption()
+            ),
             &data,
             profile,
         ),
@@ -270,12 +348,14 @@ pub fn energy_table(records: &[RunRecord], profile: &str) -> Table {
 
 /// `metric` per object (rows, plus a final "Mean" row) and model (columns, default options) on
 /// `dataset`; the best / second / third model of each row is marked. For an image metric, the
-/// noise ceiling's records add a last reference column (never ranked).
+/// noise ceiling's records add a last reference column (never ranked), and the caption names
+/// the `protocol` the records were scored under.
 pub fn per_object_table(
     records: &[RunRecord],
     ceiling: &[RunRecord],
     dataset: &Dataset,
     metric: MetricKind,
+    protocol: Protocol,
     profile: &str,
 ) -> Table {
     let last = final_records(records);
@@ -326,12 +406,12 @@ pub fn per_object_table(
         .collect();
     rows.push(Row::new("Mean", means));
     let scale = if metric.factor() == 1.0 { String::new() } else { " (×100)".to_string() };
+    let mut title = format!("{}{scale} per object and model (default options).", metric.label());
+    if MetricKind::IMAGE.contains(&metric) {
+        title = format!("{title} {}", protocol.caption());
+    }
     Table {
-        caption: caption(
-            &format!("{}{scale} per object and model (default options).", metric.label()),
-            std::slice::from_ref(dataset),
-            profile,
-        ),
+        caption: caption(&title, std::slice::from_ref(dataset), profile),
         stub_header: "Object".into(),
         groups: vec![ColumnGroup { title: dataset.label().to_string(), columns }],
         rows,
@@ -373,6 +453,7 @@ mod tests {
         assert_eq!(t.groups[1].title, "DiLiGenT-MV");
         assert_eq!(t.groups[1].columns.len(), 5);
         assert!(t.caption.contains("Data: MERL-derived (NBRDF), DiLiGenT-MV. Profile: quick."));
+        assert!(t.caption.contains("Real captures (the real-world columns): DiLiGenT-MV"));
         // Disney row (index 3), DiLiGenT-MV PSNR: (32 + 20) / 2.
         assert_eq!(t.rows[3].label, "Disney");
         assert_eq!(t.cell_text(3, 6), "26.00");
@@ -419,7 +500,7 @@ mod tests {
         assert_eq!(t.marks()[4][0], super::super::rank::Mark::First);
         assert_eq!(t.marks()[last][0], super::super::rank::Mark::None);
         // The per-object table gets the ceiling as a last, unranked column.
-        let p = per_object_table(&records, &ceiling, &d, MetricKind::Psnr, "quick");
+        let p = per_object_table(&records, &ceiling, &d, MetricKind::Psnr, Protocol::Ours, "quick");
         assert_eq!(p.columns().last().unwrap().label, CEILING_LABEL);
         assert_eq!(p.cell_text(0, 9), "45.00");
         assert_eq!(p.marks()[0][4], super::super::rank::Mark::First);
@@ -467,7 +548,15 @@ mod tests {
             rec(ModelKind::Rp, "bear", 25.0, 0.05),
             rec(ModelKind::Rp, "cow", 21.0, 0.05),
         ];
-        let t = per_object_table(&records, &[], &Dataset::DiligentMv, MetricKind::Psnr, "quick");
+        let t = per_object_table(
+            &records,
+            &[],
+            &Dataset::DiligentMv,
+            MetricKind::Psnr,
+            Protocol::Paper,
+            "quick",
+        );
+        assert!(t.caption.contains("The paper's protocol"), "{}", t.caption);
         let labels: Vec<&str> = t.rows.iter().map(|r| r.label.as_str()).collect();
         assert_eq!(labels, ["bear", "cow", "Mean"]);
         assert_eq!(t.columns().len(), 9);

@@ -6,13 +6,20 @@
 //! scene directory). Written, atomically, under `<out>/`:
 //!
 //! ```text
-//! tables/table1.{md,tex}           Table 1 (every data set present), with the noise ceiling
-//! tables/table1-noise-free.*       Table 1 against the noise-free test renders
+//! tables/table1.{md,tex}           Table 1 (every data set present) under our protocol (the
+//!                                  object mask, against the observations), with the noise
+//!                                  ceiling
+//! tables/table1-paper.*            Table 1 under the paper's protocol (the whole frame,
+//!                                  against the noise-free renders)
+//! tables/table1-noise-free.*       Table 1 against the noise-free renders, on the mask
 //! tables/nol.{md,tex}              NOL deltas            tables/reciprocity.{md,tex}
 //! tables/reciprocity-deltas.*      swap / mapping deltas tables/angles.{md,tex}
 //! tables/nerfactor.{md,tex}        NeRFactor changes     tables/energy.{md,tex}
-//! tables/per-object-psnr.*         per object            tables/per-object-rmse.*
+//! tables/per-object-psnr.*         per object (ours)     tables/per-object-rmse.*
+//! tables/per-object-psnr-paper.*   per object, the paper's protocol
 //! tables/runtime.{md,tex}         run time against accuracy (seconds to each plateau)
+//! tables/paper-vs-ours.md          the paper's Table 1 beside ours (its protocol), the ranking
+//!                                  agreement and its findings checked (`report::paper`)
 //! tables/all.md                    every table in one file
 //! figures/qualitative-<object>.png GT and every model's render with its PSNR, FLIP maps
 //! figures/split-<object>.png       additive models: render, diffuse, specular, albedo
@@ -30,7 +37,8 @@ use crate::run_dir::{RunDir, RunMetrics, SweepLayout};
 use crate::{Error, Result};
 use metrics::aggregate::Score;
 use report::{
-    self, Dataset, MetricKind, ModelRender, QualitativeRow, RgbImage, RunOptions, RunRecord, Table,
+    self, Dataset, MetricKind, ModelRender, Protocol, QualitativeRow, RgbImage, RunOptions,
+    RunRecord, Table,
 };
 use scene::flag;
 use std::path::{Path, PathBuf};
@@ -50,6 +58,9 @@ pub struct CollectedRun {
     pub noise_free: Option<RunRecord>,
     /// The noise ceiling of its scene (semi-synthetic scenes).
     pub ceiling: Option<RunRecord>,
+    /// The same run under the paper's protocol: the whole frame against the noise-free
+    /// renders (with its RMSE∛, which no protocol changes).
+    pub paper: Option<RunRecord>,
     /// Its run-time curve: the snapshots' scores and the final weights' (runs with
     /// snapshots).
     pub curve: Vec<RunRecord>,
@@ -135,6 +146,13 @@ pub fn read_run(dir: &Path) -> Result<Option<CollectedRun>> {
         r = r.with(MetricKind::EnergyMedianAbove1, opt(e.median_above_one, "no pair above 1"));
     }
     let noise_free = t.clean.as_ref().map(|c| images(base.clone(), c));
+    let paper = t.paper.as_ref().map(|p| {
+        let r = images(base.clone(), &p.scores);
+        match t.rmse_cbrt {
+            Some(v) => r.with_value(MetricKind::CubeRootRmse, v),
+            None => r,
+        }
+    });
     let ceiling = t.ceiling.as_ref().map(|c| images(base.clone(), c));
     let point = |steps: u64, seconds: f64, psnr: f64, rmse: Option<f64>| {
         let p = base
@@ -159,6 +177,7 @@ pub fn read_run(dir: &Path) -> Result<Option<CollectedRun>> {
         record: r,
         noise_free,
         ceiling,
+        paper,
         curve,
         stop_reason: m.stop_reason,
     }))
@@ -242,11 +261,13 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
     let ceiling: Vec<RunRecord> = runs.iter().filter_map(|r| r.ceiling.clone()).collect();
     let mut all_md = String::new();
     let mut all_tables: Vec<(String, Table)> = Vec::new();
+    let mut comparison = None;
     if !table_runs.is_empty() {
         let rec: Vec<RunRecord> = table_runs.iter().map(|r| r.record.clone()).collect();
         let noise_free: Vec<RunRecord> =
             table_runs.iter().filter_map(|r| r.noise_free.clone()).collect();
-        let mut tables = result_tables(&rec, &noise_free, &ceiling, profile);
+        let paper: Vec<RunRecord> = table_runs.iter().filter_map(|r| r.paper.clone()).collect();
+        let mut tables = result_tables(&rec, &noise_free, &paper, &ceiling, profile);
         let table1_runs: Vec<&CollectedRun> = table_runs
             .iter()
             .copied()
@@ -263,6 +284,17 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
         }
         write_tables(&tables, out, &mut all_md, &mut summary)?;
         all_tables.extend(tables);
+        let c = report::paper::compare(&paper, &rec, profile)
+            .map_err(|e| Error::format(Path::new("crates/report/data/paper"), e.to_string()))?;
+        let md = c.to_markdown();
+        write(
+            SweepLayout::new(out).tables().join("paper-vs-ours.md"),
+            md.as_bytes(),
+            &mut summary,
+        )?;
+        all_md.push_str(&md);
+        all_md.push('\n');
+        comparison = Some(c);
         figures(&runs, out, &mut summary)?;
         super::brdf_figures::brdf_figures(&runs, out, &mut summary)?;
     }
@@ -292,19 +324,26 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
         }
     }
     write(SweepLayout::new(out).tables().join("all.md"), all_md.as_bytes(), &mut summary)?;
-    super::html_report::write_report(out, profile, &all_tables, &runs, &mut summary)?;
+    let tables = super::html_report::Tables { all: &all_tables, paper: comparison.as_ref() };
+    super::html_report::write_report(out, profile, &tables, &runs, &mut summary)?;
     Ok(summary)
 }
 
-/// Every result table of the runs (not the run-time one), with its file stem.
+/// Every result table of the runs (not the run-time one), with its file stem: `rec` under our
+/// protocol, `noise_free` on the mask against the noise-free renders, `paper` under the paper's
+/// protocol.
 fn result_tables(
     rec: &[RunRecord],
     noise_free: &[RunRecord],
+    paper: &[RunRecord],
     ceiling: &[RunRecord],
     profile: &str,
 ) -> Vec<(String, Table)> {
     let mut tables: Vec<(String, Table)> =
         vec![("table1".into(), report::table1(rec, ceiling, profile))];
+    if !paper.is_empty() {
+        tables.push(("table1-paper".into(), report::table1_paper(paper, profile)));
+    }
     if !noise_free.is_empty() {
         tables.push(("table1-noise-free".into(), report::table1_noise_free(noise_free, profile)));
     }
@@ -322,11 +361,17 @@ fn result_tables(
         (Dataset::Diligent, "-diligent"),
     ] {
         if rec.iter().any(|r| r.dataset == d) {
-            let psnr = report::per_object_table(rec, ceiling, &d, MetricKind::Psnr, profile);
+            let ours = Protocol::Ours;
+            let psnr = report::per_object_table(rec, ceiling, &d, MetricKind::Psnr, ours, profile);
             tables.push((format!("per-object-psnr{tag}"), psnr));
+            if paper.iter().any(|r| r.dataset == d) {
+                let p = Protocol::Paper;
+                let psnr = report::per_object_table(paper, &[], &d, MetricKind::Psnr, p, profile);
+                tables.push((format!("per-object-psnr-paper{tag}"), psnr));
+            }
             if d.has_brdf_ground_truth() {
-                let rmse =
-                    report::per_object_table(rec, ceiling, &d, MetricKind::CubeRootRmse, profile);
+                let m = MetricKind::CubeRootRmse;
+                let rmse = report::per_object_table(rec, ceiling, &d, m, ours, profile);
                 tables.push((format!("per-object-rmse{tag}"), rmse));
             }
         }

@@ -2,12 +2,14 @@
 //! from the file system (inline CSS, no script, no network):
 //!
 //! ```text
-//! report/index.html              profile and data, Table 1 (with the noise ceiling), every
+//! report/index.html              profile and data, Table 1 in both protocols (ours with the
+//!                                noise ceiling, the paper's), the paper beside ours, every
 //!                                ablation and per-object table, run time, the figures (the
 //!                                qualitative grids, the BRDF plots), the runs
 //! report/runs/<run>.html         one run: training curve, the first test renders beside the
 //!                                observation and the FLIP map, how each score was computed
-//!                                (`test.settings`), metrics.json and config.toml
+//!                                in each protocol (`test.settings`, `test.paper.settings`),
+//!                                metrics.json and config.toml
 //! report/runs/<run>-curve-{steps,seconds}.png   training and validation loss against each
 //! report/observed/<object>-<stem>.png   observed test images (sRGB), shared by the run pages
 //! ```
@@ -19,6 +21,7 @@ use super::collect::{CollectSummary, CollectedRun};
 use crate::run_dir::{RunDir, SweepLayout};
 use crate::{Error, Result};
 use report::html::{Page, check_well_formed, links};
+use report::paper::PaperComparison;
 use report::{LinePlot, Series, Table};
 use std::path::{Component, Path, PathBuf};
 
@@ -54,9 +57,17 @@ fn run_page(run: &CollectedRun) -> String {
     format!("{id}.html")
 }
 
+/// The tables of the report: every result table, and the comparison with the paper.
+pub struct Tables<'a> {
+    /// (file stem, table), as written under `tables/`.
+    pub all: &'a [(String, Table)],
+    /// The paper beside ours (absent without Table 1 runs).
+    pub paper: Option<&'a PaperComparison>,
+}
+
 /// The index's sections: (heading, anchor, table stems in order).
 const SECTIONS: [(&str, &str, &[&str]); 4] = [
-    ("Table 1", "table1", &["table1", "table1-noise-free"]),
+    ("Table 1", "table1", &["table1", "table1-paper", "table1-noise-free"]),
     (
         "Ablations and analyses",
         "ablations",
@@ -70,7 +81,7 @@ const SECTIONS: [(&str, &str, &[&str]); 4] = [
 pub fn write_report(
     out: &Path,
     profile: &str,
-    tables: &[(String, Table)],
+    tables: &Tables<'_>,
     runs: &[CollectedRun],
     summary: &mut CollectSummary,
 ) -> Result<()> {
@@ -94,6 +105,7 @@ pub fn write_report(
     );
     for (heading, anchor, stems) in SECTIONS {
         let chosen: Vec<&Table> = tables
+            .all
             .iter()
             .filter(|(name, _)| {
                 stems.iter().any(|s| name == s || (s.ends_with('-') && name.starts_with(s)))
@@ -109,6 +121,11 @@ pub fn write_report(
         }
         if anchor == "runtime" {
             index.figures(&figures_matching(&dir, summary, "runtime-"));
+        }
+        if anchor == "table1"
+            && let Some(c) = tables.paper
+        {
+            paper_section(&mut index, c);
         }
     }
     let qualitative = figures_matching(&dir, summary, "qualitative-");
@@ -172,6 +189,32 @@ pub fn write_report(
         summary.files.push(path);
     }
     Ok(())
+}
+
+/// The section "The paper beside ours": where its values come from, the level of each group of
+/// rows, ours beside its Table 1, the ranking agreement and its findings on our runs.
+fn paper_section(index: &mut Page, c: &PaperComparison) {
+    let plain = |s: &str| s.replace("**", "");
+    index.heading("The paper beside ours", "paper");
+    index.paragraph(report::Protocol::Paper.caption(), true);
+    index.paragraph(&c.source_note(), true);
+    for l in c.level_lines() {
+        index.paragraph(&plain(&l), false);
+    }
+    for (_, t) in &c.tables {
+        index.table(t);
+    }
+    for m in &c.missing {
+        index.paragraph(m, true);
+    }
+    index.paragraph("Ranking agreement (Kendall's τ-b over the nine models, MERL half):", false);
+    for l in c.agreement_lines() {
+        index.paragraph(&l, true);
+    }
+    index.paragraph("The paper's findings on our runs:", false);
+    for f in &c.findings {
+        index.paragraph(&format!("{}: {}. {}.", f.verdict(), f.claim, f.evidence), false);
+    }
 }
 
 /// `p` made absolute with `.` and `..` resolved lexically.
@@ -274,11 +317,16 @@ fn run_page_html(
     let metrics =
         std::fs::read_to_string(run.metrics()).map_err(|e| Error::io(run.metrics(), e))?;
     let json: serde_json::Value = serde_json::from_str(&metrics).unwrap_or_default();
-    if let Some(settings) = json.pointer("/test/settings").and_then(|v| v.as_object()) {
-        page.heading("How the scores were computed", "settings");
-        for (key, value) in settings {
-            let text = value.as_str().map_or_else(|| value.to_string(), String::from);
-            page.paragraph(&format!("{key}: {text}"), false);
+    for (pointer, heading, anchor) in [
+        ("/test/settings", "How the scores were computed (our protocol)", "settings"),
+        ("/test/paper/settings", "How the scores were computed (the paper's protocol)", "paper"),
+    ] {
+        if let Some(settings) = json.pointer(pointer).and_then(|v| v.as_object()) {
+            page.heading(heading, anchor);
+            for (key, value) in settings {
+                let text = value.as_str().map_or_else(|| value.to_string(), String::from);
+                page.paragraph(&format!("{key}: {text}"), false);
+            }
         }
     }
     page.heading("metrics.json", "metrics");
