@@ -104,7 +104,7 @@ enum Command {
     /// every run (finished runs are skipped, interrupted ones resume), then write the tables
     /// (Markdown, LaTeX) and figures (PNG) into OUT/tables and OUT/figures.
     ReproduceTables {
-        /// Built-in profile (smoke, quick, runtime, full) or a profile TOML file.
+        /// Built-in profile (default, quick, smoke, runtime, full, real) or a profile TOML file.
         #[arg(long, default_value = experiments::sweep::DEFAULT_PROFILE)]
         profile: String,
         /// Output directory (scenes, runs, cache, tables, figures).
@@ -119,7 +119,8 @@ enum Command {
         /// instead of running them; then `cargo xtask collect`.
         #[arg(long)]
         emit_jobs: Option<PathBuf>,
-        /// Data root for the profile's `data:` meshes (default: $NEURAL_BRDF_DATA, else ./data).
+        /// Data root for the profile's `data:` meshes and its captures (default:
+        /// $NEURAL_BRDF_DATA, else ./data).
         #[arg(long)]
         data: Option<PathBuf>,
         /// The burn backend of every run: `cpu` (default), `wgpu` or `cuda` (an xtask built with

@@ -74,8 +74,25 @@ fn a_miniature_sweep_produces_every_table_and_resumes() {
         "Ground truth (noise ceiling)",
         "below ceiling",
         "Not converged: 3 of 3 runs",
+        "Our protocol: the object mask",
     ] {
         assert!(t1.contains(name), "{name} missing from\n{t1}");
+    }
+    // Both protocols: Table 1 and the per-object PSNR under the paper's too, captioned so, and
+    // the paper's Table 1 beside ours with the ranking agreement and the findings.
+    for (f, needles) in [
+        ("table1-paper.md", &["The paper's protocol: the whole frame", "RMSE∛"][..]),
+        ("per-object-psnr-paper.md", &["The paper's protocol", "Mean"][..]),
+        ("per-object-psnr.md", &["Our protocol"][..]),
+        (
+            "paper-vs-ours.md",
+            &["## Level", "## Ranking agreement", "## The paper's findings", "not transcribed"][..],
+        ),
+    ] {
+        let text = std::fs::read_to_string(out.join("tables").join(f)).unwrap();
+        for n in needles {
+            assert!(text.contains(n), "{n} missing from {f}:\n{text}");
+        }
     }
     let runtime = std::fs::read_to_string(out.join("tables/runtime.md")).unwrap();
     assert!(runtime.contains("s to -0.5 dB") && runtime.contains("Single MLP"), "{runtime}");
@@ -122,6 +139,42 @@ fn a_miniature_sweep_produces_every_table_and_resumes() {
         .unwrap();
     let dir = PathBuf::from(String::from_utf8(echoed.stdout).unwrap());
     assert!(dir.starts_with(&out) && dir.join("config.toml").is_file(), "{}", dir.display());
+}
+
+/// The real-world half in miniature: the DiLiGenT ball of the shared data imported as the
+/// profile's capture, two models briefly trained, Table 1 with its real-world column in both
+/// protocols and the finding on real captures checked against a MERL-derived scene's gap.
+#[test]
+fn a_real_capture_sweep_gives_the_real_world_column() {
+    let Some(data) = shared_data() else { return };
+    let tmp = test_support::TempDir::new("real-sweep");
+    let out = tmp.0.join("out");
+    let text = PROFILE
+        .replace("ablations = [\"nol\"]\nruntime_curve = true\n", "")
+        .replace("\"additive_shared_enhanced\"", "")
+        .replace("lights = 4\n", "lights = 4\ncaptures = [\"diligent:ball\"]\n");
+    let profile = SweepProfile::parse(&text, "mini-real.toml").unwrap();
+    let s = sweep::sweep(&profile, &out, &data, &Execution::InProcess(Default::default())).unwrap();
+    assert!(s.failed.is_empty(), "{:?}", s.failed);
+    assert_eq!(s.runs.len(), 4, "2 models x (1 generated scene + the ball)");
+    sweep::collect(&[out.join("runs")], &out, "mini-real").unwrap();
+    let read = |f: &str| std::fs::read_to_string(out.join("tables").join(f)).unwrap();
+    for f in ["table1.md", "table1-paper.md"] {
+        let t = read(f);
+        assert!(t.contains("| DiLiGenT"), "{f} has no DiLiGenT column:\n{t}");
+        assert!(t.contains("Real captures (the real-world columns): DiLiGenT"), "{t}");
+    }
+    assert!(read("per-object-psnr-paper-diligent.md").contains("| ball |"));
+    let cmp = read("paper-vs-ours.md");
+    let real = cmp.lines().find(|l| l.contains("On real captures")).unwrap();
+    assert!(real.contains("on DiLiGenT") && !real.contains("not checked"), "{real}");
+    // The ball's run scored both protocols; a capture has no noise-free image.
+    let run = s.runs.iter().find(|d| d.to_string_lossy().contains("ball__disney")).unwrap();
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("metrics.json")).unwrap()).unwrap();
+    let settings = m.pointer("/test/paper/settings/image_input").unwrap().as_str().unwrap();
+    assert!(settings.contains("outside the object mask set to 0"), "{settings}");
+    assert!(m.pointer("/test/clean").is_none() && m.pointer("/test/paper/scores/psnr").is_some());
 }
 
 /// The built-in smoke profile (the shipped Spot mesh, no shared data needed): all 9 models and
@@ -188,6 +241,8 @@ fn the_smoke_profile_runs_end_to_end() {
     }
     let run_html = std::fs::read_to_string(&pages[0]).unwrap();
     assert!(run_html.contains("How the scores were computed"), "metric settings on the run page");
+    assert!(run_html.contains("computed (the paper"), "the paper's protocol on the run page");
+    assert!(html.contains("The paper beside ours") && html.contains("Kendall"), "{html}");
     assert!(run_html.contains("pixels per degree") && run_html.contains("-curve-steps.png"));
     browser_check(&index, "smoke-report-index");
     browser_check(&pages[0], "smoke-report-run");

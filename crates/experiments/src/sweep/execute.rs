@@ -7,8 +7,8 @@
 //! (resuming from the last checkpoint) and evaluates it. A killed sweep therefore resumes with
 //! nothing lost but the steps since the last checkpoint.
 
-use super::plan::{self, Purpose, RunInfo, RunSpec, SceneSpec};
-use super::profile::{SweepProfile, resolve_mesh};
+use super::plan::{self, Purpose, RunInfo, RunSpec, SceneSource, SceneSpec};
+use super::profile::{CaptureSource, SweepProfile, resolve_mesh};
 use crate::config::SpatialKind;
 use crate::eval::fitted::FittedRun;
 use crate::run_dir::{RunDir, SweepLayout};
@@ -124,7 +124,8 @@ pub fn run_one(run: &Path, progress: bool, backend: Backend) -> Result<()> {
     Ok(())
 }
 
-/// Generates the profile's scenes under `scenes_dir` (complete ones are kept).
+/// Generates the profile's semi-synthetic scenes and imports its captures under `scenes_dir`
+/// (complete ones are kept).
 pub fn prepare_scenes(
     profile: &SweepProfile,
     scenes: &[SceneSpec],
@@ -136,17 +137,22 @@ pub fn prepare_scenes(
     let settings = SceneSettings::with_counts(d.size, d.views, d.lights);
     let mut dirs = Vec::new();
     for (i, s) in scenes.iter().enumerate() {
-        let config = SceneConfig {
-            mesh: resolve_mesh(&s.mesh, data_root)?,
-            material: MaterialSpec::Merl { name: s.material.clone() },
-            seed: d.seed,
-            settings: settings.clone(),
-            merl_dir: None,
-        };
         let out = scenes_dir.join(&s.name);
         eprintln!("scene {}/{}: {}", i + 1, scenes.len(), s.name);
-        let r = generate_scene(&config, &out, true)?;
-        if r.skipped {
+        let skipped = match &s.source {
+            SceneSource::Generated { mesh, material } => {
+                let config = SceneConfig {
+                    mesh: resolve_mesh(mesh, data_root)?,
+                    material: MaterialSpec::Merl { name: material.clone() },
+                    seed: d.seed,
+                    settings: settings.clone(),
+                    merl_dir: None,
+                };
+                generate_scene(&config, &out, true)?.skipped
+            }
+            SceneSource::Captured(capture) => import_capture(capture, data_root, &out)?,
+        };
+        if skipped {
             summary.scenes_kept += 1;
         } else {
             summary.scenes_generated += 1;
@@ -154,6 +160,28 @@ pub fn prepare_scenes(
         dirs.push(out);
     }
     Ok(dirs)
+}
+
+/// Imports a real capture into the scene directory `out` with the importer's defaults (the
+/// paper's 30 training and 12 test lights a view); a complete scene already there is kept
+/// (returns `true`).
+fn import_capture(capture: &CaptureSource, data_root: &Path, out: &Path) -> Result<bool> {
+    if SceneDataset::open(out).is_ok() {
+        return Ok(true);
+    }
+    let src = capture.find(data_root)?;
+    let report = if src.join("view_01").is_dir() {
+        let o = dataset_diligent::MultiViewOptions { progress: true, ..Default::default() };
+        dataset_diligent::import_multi_view(&src, out, &o)
+    } else {
+        let o = dataset_diligent::SingleViewOptions { progress: true, ..Default::default() };
+        dataset_diligent::import_single_view(&src, out, &o)
+    }
+    .map_err(|e| Error::format(&src, format!("importing the capture: {e}")))?;
+    for w in &report.warnings {
+        eprintln!("  warning: {w}");
+    }
+    Ok(false)
 }
 
 /// Creates (or finds) the directory of every planned run: `config.toml` with the scene path,
@@ -184,7 +212,7 @@ pub fn prepare_runs(
         let info = RunInfo {
             id,
             object: object.clone(),
-            dataset: "MERL-derived (NBRDF)".into(),
+            dataset: scenes[spec.scene].dataset(Some(&scene_dirs[spec.scene])),
             purposes,
             code_version: plan::CODE_VERSION.into(),
         };
@@ -343,6 +371,11 @@ pub fn sweep(
 ) -> Result<SweepSummary> {
     let start = Instant::now();
     let mut summary = SweepSummary::default();
+    let (profile, notes) = profile.clone().with_captures_found(data_root)?;
+    for n in &notes {
+        eprintln!("{n}");
+    }
+    let profile = &profile;
     let layout = SweepLayout::new(out);
     let (scenes_dir, runs_dir, cache) = (layout.scenes(), layout.runs(), layout.cache());
     let scenes = plan::scenes(profile);

@@ -7,7 +7,7 @@
 //! and two profiles that share a run (the quick profile and the run-time curve) share its
 //! directory.
 
-use super::profile::{Ablation, SweepProfile, mesh_name};
+use super::profile::{Ablation, CaptureSource, SweepProfile, mesh_name};
 use crate::config::RunConfig;
 use crate::run_dir::RunDir;
 use crate::{Error, Result};
@@ -36,12 +36,35 @@ pub enum Purpose {
 /// One scene of the sweep.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SceneSpec {
-    /// `<mesh>__<material>`.
+    /// `<mesh>__<material>` for a semi-synthetic scene, the object's name for a capture.
     pub name: String,
-    /// Mesh source as written in the profile.
-    pub mesh: String,
-    /// Catalogue material.
-    pub material: String,
+    /// Where it comes from.
+    pub source: SceneSource,
+}
+
+/// Where a scene of the sweep comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SceneSource {
+    /// Rendered from a mesh and a catalogue material.
+    Generated {
+        /// Mesh source as written in the profile.
+        mesh: String,
+        /// Catalogue material.
+        material: String,
+    },
+    /// Imported from a real capture.
+    Captured(CaptureSource),
+}
+
+impl SceneSpec {
+    /// The data set label of its runs (`run.json`, the tables' column groups); `dir` is the
+    /// capture's directory, for a capture given by path.
+    pub fn dataset(&self, dir: Option<&Path>) -> String {
+        match &self.source {
+            SceneSource::Generated { .. } => "MERL-derived (NBRDF)".into(),
+            SceneSource::Captured(c) => c.dataset(dir.unwrap_or(Path::new(""))).into(),
+        }
+    }
 }
 
 /// One run of the sweep.
@@ -71,17 +94,19 @@ pub struct RunInfo {
     pub code_version: String,
 }
 
-/// The scenes of a profile, in order.
+/// The scenes of a profile, in order: the semi-synthetic ones, then the captures (the optional
+/// ones as [`SweepProfile::with_captures_found`] left them).
 pub fn scenes(profile: &SweepProfile) -> Vec<SceneSpec> {
-    profile
-        .scenes()
-        .into_iter()
-        .map(|(mesh, material)| SceneSpec {
-            name: format!("{}__{material}", mesh_name(&mesh)),
-            mesh,
-            material,
-        })
-        .collect()
+    let generated = profile.scenes().into_iter().map(|(mesh, material)| SceneSpec {
+        name: format!("{}__{material}", mesh_name(&mesh)),
+        source: SceneSource::Generated { mesh, material },
+    });
+    let captured =
+        profile.data.captures.iter().chain(&profile.data.optional_captures).filter_map(|c| {
+            let source = CaptureSource::parse(c).ok()?;
+            Some(SceneSpec { name: source.object(), source: SceneSource::Captured(source) })
+        });
+    generated.chain(captured).collect()
 }
 
 /// The purely neural models (the NOL, reciprocity and angle ablations apply to them).

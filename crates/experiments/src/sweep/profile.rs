@@ -1,7 +1,7 @@
 //! Sweep profiles: which scenes, models, ablations and training budgets a reproduction runs.
 //!
 //! A profile is a TOML file. The built-in ones live in `crates/experiments/profiles/` and are
-//! compiled in (`default`, `smoke`, `quick`, `runtime`, `full`); `--profile` takes one of those names or
+//! compiled in (`default`, `smoke`, `quick`, `runtime`, `full`, `real`); `--profile` takes one of those names or
 //! a path to a file of the same shape:
 //!
 //! ```toml
@@ -15,6 +15,8 @@
 //! size = 128                      # image width = height
 //! views = 20                      # half train, half test
 //! lights = 42                     # per view; 30/42 of them train
+//! captures = ["diligent:ball"]    # real captures, imported as scenes (see [`CaptureSource`])
+//! optional_captures = ["diligent-mv:bear"]   # the same, used when present under the data root
 //!
 //! [run]                           # a run configuration (see `experiments::config`), shared
 //! seed = 1
@@ -37,12 +39,13 @@ use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
 /// The built-in profiles: (name, TOML text).
-pub const BUILT_IN: [(&str, &str); 5] = [
+pub const BUILT_IN: [(&str, &str); 6] = [
     ("default", include_str!("../../profiles/default.toml")),
     ("smoke", include_str!("../../profiles/smoke.toml")),
     ("quick", include_str!("../../profiles/quick.toml")),
     ("runtime", include_str!("../../profiles/runtime.toml")),
     ("full", include_str!("../../profiles/full.toml")),
+    ("real", include_str!("../../profiles/real.toml")),
 ];
 
 /// The profile `reproduce-tables` runs without `--profile`: Table 1 with every run trained to
@@ -50,23 +53,35 @@ pub const BUILT_IN: [(&str, &str); 5] = [
 /// of the first scene.
 pub const DEFAULT_PROFILE: &str = "default";
 
-/// The scenes of a profile.
+/// The scenes of a profile: semi-synthetic ones (meshes x materials) and real captures.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DataSection {
     /// Mesh sources: `embedded:NAME`, `data:PATH` (under the data root) or a file path.
+    #[serde(default)]
     pub meshes: Vec<String>,
     /// Catalogue material names.
+    #[serde(default)]
     pub materials: Vec<String>,
     /// `product` (default) or `zip`.
     #[serde(default)]
     pub pairing: Pairing,
-    /// Image width and height.
+    /// Image width and height of the semi-synthetic scenes.
+    #[serde(default)]
     pub size: u32,
-    /// Views per scene (half train, half test).
+    /// Views per semi-synthetic scene (half train, half test).
+    #[serde(default)]
     pub views: usize,
-    /// Lights per view.
+    /// Lights per view of the semi-synthetic scenes.
+    #[serde(default)]
     pub lights: usize,
+    /// Real captures, imported as scenes ([`CaptureSource`]); a missing one is an error that
+    /// says where to get it.
+    #[serde(default)]
+    pub captures: Vec<String>,
+    /// Real captures used when present under the data root, skipped with a note otherwise.
+    #[serde(default)]
+    pub optional_captures: Vec<String>,
     /// Seed of cameras, lights, splits and noise (default 1).
     #[serde(default = "one")]
     pub seed: u64,
@@ -204,19 +219,35 @@ impl SweepProfile {
     fn validate(&self) -> Result<()> {
         let bad =
             |key: &str, why: String| Err(Error::config(key, format!("{why} (in {})", self.origin)));
-        if self.data.meshes.is_empty() {
-            return bad("data.meshes", "is empty".into());
+        let d = &self.data;
+        let captured = d.captures.len() + d.optional_captures.len();
+        if d.meshes.is_empty() != d.materials.is_empty() {
+            let (key, other) = if d.meshes.is_empty() {
+                ("data.meshes", "data.materials")
+            } else {
+                ("data.materials", "data.meshes")
+            };
+            return bad(key, format!("is empty, but {other} is not"));
         }
-        if self.data.materials.is_empty() {
-            return bad("data.materials", "is empty".into());
+        if d.meshes.is_empty() && captured == 0 {
+            return bad("data", "has no scenes: give meshes and materials, or captures".into());
         }
-        for m in &self.data.materials {
+        for m in &d.materials {
             if dataset_merl::catalogue::entry(m).is_err() {
                 return bad("data.materials", format!("{m} is not a catalogue material"));
             }
         }
-        if self.data.views < 2 || self.data.lights < 2 || self.data.size < 8 {
+        if !d.meshes.is_empty() && (d.views < 2 || d.lights < 2 || d.size < 8) {
             return bad("data", "needs views >= 2, lights >= 2, size >= 8".into());
+        }
+        for (key, list) in
+            [("data.captures", &d.captures), ("data.optional_captures", &d.optional_captures)]
+        {
+            for c in list {
+                if let Err(e) = CaptureSource::parse(c) {
+                    return bad(key, e);
+                }
+            }
         }
         self.models()?;
         self.ablations()?;
@@ -230,23 +261,51 @@ impl SweepProfile {
         Ok(())
     }
 
-    /// Number of scenes.
+    /// Number of scenes: the semi-synthetic ones, then the captures (optional ones included
+    /// until [`SweepProfile::with_captures_found`] has dropped the missing ones).
     pub fn scene_count(&self) -> usize {
         let (a, b) = (self.data.meshes.len(), self.data.materials.len());
-        match self.data.pairing {
+        let generated = match self.data.pairing {
+            _ if a == 0 || b == 0 => 0,
             Pairing::Product => a * b,
             Pairing::Zip => a.max(b),
-        }
+        };
+        generated + self.data.captures.len() + self.data.optional_captures.len()
     }
 
-    /// (mesh source, material) of every scene, in order.
+    /// The profile with its captures looked up under `data_root`: the optional ones present
+    /// join the captures, the missing ones are dropped (each with a note saying where to get
+    /// it); a missing required capture is an error saying what is missing and where to get it.
+    pub fn with_captures_found(mut self, data_root: &Path) -> Result<(Self, Vec<String>)> {
+        let mut notes = Vec::new();
+        for c in &self.data.captures {
+            CaptureSource::parse(c)
+                .map_err(|e| Error::config("data.captures", e))?
+                .find(data_root)?;
+        }
+        for c in std::mem::take(&mut self.data.optional_captures) {
+            let source =
+                CaptureSource::parse(&c).map_err(|e| Error::config("data.optional_captures", e))?;
+            match source.find(data_root) {
+                Ok(_) => self.data.captures.push(c),
+                Err(e) => notes.push(format!("skipped {c}: {e}")),
+            }
+        }
+        Ok((self, notes))
+    }
+
+    /// (mesh source, material) of every semi-synthetic scene, in order (the captures follow
+    /// them in the sweep's scene list).
     pub fn scenes(&self) -> Vec<(String, String)> {
         let (m, t) = (&self.data.meshes, &self.data.materials);
+        if m.is_empty() || t.is_empty() {
+            return Vec::new();
+        }
         match self.data.pairing {
             Pairing::Product => {
                 m.iter().flat_map(|a| t.iter().map(move |b| (a.clone(), b.clone()))).collect()
             }
-            Pairing::Zip => (0..self.scene_count())
+            Pairing::Zip => (0..m.len().max(t.len()))
                 .map(|i| (m[i % m.len()].clone(), t[i % t.len()].clone()))
                 .collect(),
         }
@@ -287,6 +346,114 @@ impl SweepProfile {
                 )),
             })
             .collect()
+    }
+}
+
+/// A real capture of a profile: `diligent:NAME` (a single-view DiLiGenT object, so far the
+/// ball), `diligent-mv:NAME` (a DiLiGenT-MV object: bear, buddha, cow, pot2, reading), or
+/// `data:PATH` / a path to a capture directory of either layout.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum CaptureSource {
+    /// A single-view DiLiGenT object.
+    Diligent(String),
+    /// A DiLiGenT-MV object.
+    DiligentMv(String),
+    /// A capture directory: under the data root (`data:`), or a path.
+    Path {
+        /// The path as written, without `data:`.
+        path: String,
+        /// Whether it is relative to the data root.
+        under_root: bool,
+    },
+}
+
+impl CaptureSource {
+    /// Parses a profile's capture entry.
+    pub fn parse(s: &str) -> std::result::Result<Self, String> {
+        let name = |n: &str| -> std::result::Result<String, String> {
+            if n.is_empty() || !n.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+                Err(format!("{s:?}: {n:?} is not an object name"))
+            } else {
+                Ok(n.to_string())
+            }
+        };
+        if let Some(n) = s.strip_prefix("diligent-mv:") {
+            Ok(CaptureSource::DiligentMv(name(n)?))
+        } else if let Some(n) = s.strip_prefix("diligent:") {
+            Ok(CaptureSource::Diligent(name(n)?))
+        } else if let Some(p) = s.strip_prefix("data:") {
+            Ok(CaptureSource::Path { path: p.to_string(), under_root: true })
+        } else if s.is_empty() {
+            Err("an empty capture entry".into())
+        } else {
+            Ok(CaptureSource::Path { path: s.to_string(), under_root: false })
+        }
+    }
+
+    /// The object's name (the scene's name in the sweep).
+    pub fn object(&self) -> String {
+        match self {
+            CaptureSource::Diligent(n) | CaptureSource::DiligentMv(n) => n.clone(),
+            CaptureSource::Path { path, .. } => {
+                let p = Path::new(path.trim_end_matches('/'));
+                let n = p.file_name().and_then(|n| n.to_str()).unwrap_or("capture");
+                n.strip_suffix("PNG").unwrap_or(n).to_string()
+            }
+        }
+    }
+
+    /// The directories it may be in, in the order they are tried: a benchmark's layout as the
+    /// shared data has it and as `cargo xtask fetch-data` unpacks its zip.
+    pub fn candidates(&self, data_root: &Path) -> Vec<PathBuf> {
+        match self {
+            CaptureSource::Diligent(n) => vec![
+                data_root.join(format!("diligent/pmsData/{n}PNG")),
+                data_root.join(format!("diligent/DiLiGenT/pmsData/{n}PNG")),
+            ],
+            CaptureSource::DiligentMv(n) => vec![
+                data_root.join(format!("diligent-mv/mvpmsData/{n}PNG")),
+                data_root.join(format!("diligent-mv/DiLiGenT-MV/mvpmsData/{n}PNG")),
+            ],
+            CaptureSource::Path { path, under_root: true } => vec![data_root.join(path)],
+            CaptureSource::Path { path, under_root: false } => vec![PathBuf::from(path)],
+        }
+    }
+
+    /// The capture's directory under `data_root`, or an error naming every place looked in
+    /// and how to get the data.
+    pub fn find(&self, data_root: &Path) -> Result<PathBuf> {
+        let candidates = self.candidates(data_root);
+        if let Some(dir) = candidates.iter().find(|d| d.is_dir()) {
+            return Ok(dir.clone());
+        }
+        let how = match self {
+            CaptureSource::Diligent(_) => {
+                "get DiLiGenT with `cargo xtask fetch-data diligent` (a zip downloaded by hand: \
+                 data-manifests/diligent.toml says from where), or point NEURAL_BRDF_DATA (or \
+                 --data) at a data root that has it"
+            }
+            CaptureSource::DiligentMv(_) => {
+                "get DiLiGenT-MV with `cargo xtask fetch-data diligent-mv` (a zip downloaded by \
+                 hand: data-manifests/diligent-mv.toml says from where), or point \
+                 NEURAL_BRDF_DATA (or --data) at a data root that has it"
+            }
+            CaptureSource::Path { .. } => "check the path",
+        };
+        let looked: Vec<String> = candidates.iter().map(|c| c.display().to_string()).collect();
+        Err(Error::format(
+            &candidates[0],
+            format!("capture not found (looked in {}); {how}", looked.join(" and ")),
+        ))
+    }
+
+    /// The data set label its runs carry.
+    pub fn dataset(&self, dir: &Path) -> &'static str {
+        match self {
+            CaptureSource::Diligent(_) => "DiLiGenT",
+            CaptureSource::DiligentMv(_) => "DiLiGenT-MV",
+            CaptureSource::Path { .. } if dir.join("view_01").is_dir() => "DiLiGenT-MV",
+            CaptureSource::Path { .. } => "DiLiGenT",
+        }
     }
 }
 
@@ -362,6 +529,48 @@ mod tests {
         assert!(e.contains("learnig_rate"), "{e}");
         let e = SweepProfile::load("nonexistent-profile").unwrap_err().to_string();
         assert!(e.contains("built-in"), "{e}");
+    }
+
+    #[test]
+    fn capture_sources_parse_and_missing_ones_say_where_to_get_them() {
+        assert_eq!(
+            CaptureSource::parse("diligent:ball"),
+            Ok(CaptureSource::Diligent("ball".into()))
+        );
+        assert_eq!(
+            CaptureSource::parse("diligent-mv:bear"),
+            Ok(CaptureSource::DiligentMv("bear".into()))
+        );
+        assert!(CaptureSource::parse("diligent:../x").is_err());
+        assert_eq!(CaptureSource::parse("data:caps/potPNG").unwrap().object(), "pot");
+        let root = Path::new("/nonexistent-data-root");
+        let e = CaptureSource::parse("diligent:ball").unwrap().find(root).unwrap_err().to_string();
+        assert!(e.contains("fetch-data diligent") && e.contains("ballPNG"), "{e}");
+        // The real profile: the ball is required, DiLiGenT-MV's objects are optional.
+        let real = SweepProfile::load("real").unwrap();
+        assert!(
+            real.clone().with_captures_found(root).unwrap_err().to_string().contains("ballPNG")
+        );
+        let mut ball_only = real.clone();
+        ball_only.data.captures.clear();
+        let (found, notes) = ball_only.with_captures_found(root).unwrap();
+        assert!(found.data.captures.is_empty() && found.data.optional_captures.is_empty());
+        assert_eq!(notes.len(), 5);
+        assert!(
+            notes[0].contains("diligent-mv") && notes[0].contains("fetch-data"),
+            "{}",
+            notes[0]
+        );
+    }
+
+    #[test]
+    fn a_profile_needs_scenes() {
+        let text = "name = \"x\"\n[data]\n[sweep]\nmodels = [\"all\"]\n";
+        let e = SweepProfile::parse(text, "x.toml").unwrap_err().to_string();
+        assert!(e.contains("no scenes"), "{e}");
+        let text = "name = \"x\"\n[data]\nmeshes = [\"embedded:spot\"]\n";
+        let e = SweepProfile::parse(text, "x.toml").unwrap_err().to_string();
+        assert!(e.contains("data.materials"), "{e}");
     }
 
     #[test]
