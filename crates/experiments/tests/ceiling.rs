@@ -114,6 +114,15 @@ fn the_papers_protocol_scores_the_whole_frame_against_the_noise_free_renders() {
         whole.psnr - masked.psnr
     );
     assert!(expected > 3.0, "the object covers less than half the frame: {expected}");
+    // The reading against the observations (background set to 0): the same identity with our
+    // masked score against the observations.
+    let observed = off.paper_observed.clone().unwrap();
+    assert!(
+        (observed.psnr - off.model.psnr - expected).abs() < 1e-9,
+        "whole {} - masked {} against the observations, expected {expected}",
+        observed.psnr,
+        off.model.psnr
+    );
     // The background adds no error: the whole frame's FLIP and DSSIM are below the mask's.
     assert!(whole.flip < masked.flip && whole.dssim < masked.dssim, "{whole:?} {masked:?}");
     assert_eq!(off.frame_pixels, pairs.len() * size * size);

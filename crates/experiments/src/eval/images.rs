@@ -25,7 +25,10 @@
 //! included, against the noise-free render (a capture has none: its observation with the
 //! background set to 0). The background is exactly 0 in the render and that reference, so the
 //! whole frame's PSNR exceeds the masked one by 10 log10(frame pixels / object pixels) when
-//! the scores are against the same reference, and an exact model scores +inf dB.
+//! the scores are against the same reference, and an exact model scores +inf dB. The paper
+//! does not say which reference it used, so a generated scene is also scored over the whole
+//! frame against its observation with the background set to 0
+//! ([`ImageScores::paper_observed`]): the reading that keeps the sensor noise.
 //!
 //! Written into the run directory when images are on:
 //!
@@ -99,6 +102,10 @@ pub struct ImageScores {
     /// the observations with the background set to 0) over the whole frame
     /// ([`whole_frame`]).
     pub paper: Option<ImageMetrics>,
+    /// The paper's whole frame against the observations instead, their background set to 0
+    /// (semi-synthetic scenes: the other reading of the paper's protocol, which keeps the
+    /// sensor noise in the reference; a capture's `paper` already is this).
+    pub paper_observed: Option<ImageMetrics>,
     /// The model against the noise-free test images (semi-synthetic scenes).
     pub clean: Option<ImageMetrics>,
     /// The noise ceiling: the noise-free images against the observed ones (semi-synthetic
@@ -259,27 +266,32 @@ pub fn render_and_score(
         // Every comparison of a test image shares the observed image's FLIP exposures (a
         // noise-free image can be black where every lit pixel faces away).
         let exposures = Some((flip.start_exposure, flip.stop_exposure));
-        let mut scores = PairScores { model, clean: None, ceiling: None, paper: None };
+        let mut scores =
+            PairScores { model, clean: None, ceiling: None, paper: None, paper_observed: None };
+        // The observation with its background set to 0, scored over the whole frame: the
+        // paper's protocol for a capture, its other reading for a generated scene. The masked
+        // LPIPS blacks out both backgrounds: it is the whole frame's here.
+        let reference = background_removed(&observed, &mask)?;
+        let config = metrics::flip::FlipConfig {
+            start_exposure: exposures.map(|e| e.0),
+            stop_exposure: exposures.map(|e| e.1),
+            ..Default::default()
+        };
+        let f = metrics::hdr_flip_with(&test, &reference, None, &config)?;
+        let against_observed = whole_frame(&test, &reference, &f, scores.model.lpips)?;
         if let Some(noise_free) = dataset.clean_image(vi, li)? {
             let noise_free = to_image(w, h, &noise_free)?;
             let (clean, clean_flip) = score(&test, &noise_free, &mask, opts.lpips, exposures)?;
             // Both images are 0 outside the mask: the masked LPIPS is the whole frame's.
             scores.paper = Some(whole_frame(&test, &noise_free, &clean_flip, clean.lpips)?);
+            scores.paper_observed = Some(against_observed);
             scores.clean = Some(clean);
             if !opts.skip_ceiling {
                 scores.ceiling =
                     Some(score(&noise_free, &observed, &mask, opts.lpips, exposures)?.0);
             }
         } else {
-            let reference = background_removed(&observed, &mask)?;
-            let config = metrics::flip::FlipConfig {
-                start_exposure: exposures.map(|e| e.0),
-                stop_exposure: exposures.map(|e| e.1),
-                ..Default::default()
-            };
-            let f = metrics::hdr_flip_with(&test, &reference, None, &config)?;
-            // The masked LPIPS blacks out both backgrounds: it is the whole frame's here.
-            scores.paper = Some(whole_frame(&test, &reference, &f, scores.model.lpips)?);
+            scores.paper = Some(against_observed);
         }
         if let Some(out) = &out {
             let stem = format!("view{vi:03}_light{li:03}");
@@ -302,11 +314,15 @@ pub fn render_and_score(
     };
     bar.finish_and_clear();
     let (mut model, mut clean, mut ceiling) = (ImageMetrics::default(), None, None);
-    let mut paper: Option<ImageMetrics> = None;
+    let (mut paper, mut paper_observed): (Option<ImageMetrics>, Option<ImageMetrics>) =
+        (None, None);
     for s in &per_pair {
         model.add(&s.model);
         if let Some(p) = &s.paper {
             paper.get_or_insert_with(ImageMetrics::default).add(p);
+        }
+        if let Some(p) = &s.paper_observed {
+            paper_observed.get_or_insert_with(ImageMetrics::default).add(p);
         }
         if let Some(c) = &s.clean {
             clean.get_or_insert_with(ImageMetrics::default).add(c);
@@ -328,6 +344,7 @@ pub fn render_and_score(
     Ok(ImageScores {
         model: model.divided(n),
         paper: paper.map(|p| p.divided(n)),
+        paper_observed: paper_observed.map(|p| p.divided(n)),
         frame_pixels: n * w * h,
         clean: clean.map(|c| c.divided(n)),
         ceiling: ceiling.map(|c| c.divided(n)),
@@ -342,6 +359,7 @@ struct PairScores {
     clean: Option<ImageMetrics>,
     ceiling: Option<ImageMetrics>,
     paper: Option<ImageMetrics>,
+    paper_observed: Option<ImageMetrics>,
 }
 
 /// The mean PSNR of the renders of `f` (one BRDF value per record of `data`) against the

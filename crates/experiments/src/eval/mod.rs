@@ -277,6 +277,7 @@ pub fn eval_fitted(
         flip: scores.model.flip,
         paper: scores.paper.map(|p| metric_settings::PaperProtocol {
             scores: p,
+            observed: scores.paper_observed,
             settings: metric_settings::PaperSettings::current(
                 scores.images,
                 scores.frame_pixels,

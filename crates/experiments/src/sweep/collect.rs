@@ -11,6 +11,7 @@
 //!                                  ceiling
 //! tables/table1-paper.*            Table 1 under the paper's protocol (the whole frame,
 //!                                  against the noise-free renders)
+//! tables/table1-paper-observed.*   the same frames against the observations (background 0)
 //! tables/table1-noise-free.*       Table 1 against the noise-free renders, on the mask
 //! tables/nol.{md,tex}              NOL deltas            tables/reciprocity.{md,tex}
 //! tables/reciprocity-deltas.*      swap / mapping deltas tables/angles.{md,tex}
@@ -61,6 +62,9 @@ pub struct CollectedRun {
     /// The same run under the paper's protocol: the whole frame against the noise-free
     /// renders (with its RMSE∛, which no protocol changes).
     pub paper: Option<RunRecord>,
+    /// The paper's whole frame against the observations, background set to 0 (generated
+    /// scenes; a capture's `paper` already is this).
+    pub paper_observed: Option<RunRecord>,
     /// Its run-time curve: the snapshots' scores and the final weights' (runs with
     /// snapshots).
     pub curve: Vec<RunRecord>,
@@ -146,13 +150,16 @@ pub fn read_run(dir: &Path) -> Result<Option<CollectedRun>> {
         r = r.with(MetricKind::EnergyMedianAbove1, opt(e.median_above_one, "no pair above 1"));
     }
     let noise_free = t.clean.as_ref().map(|c| images(base.clone(), c));
-    let paper = t.paper.as_ref().map(|p| {
-        let r = images(base.clone(), &p.scores);
+    let with_rmse = |m: &ImageMetrics| {
+        let r = images(base.clone(), m);
         match t.rmse_cbrt {
             Some(v) => r.with_value(MetricKind::CubeRootRmse, v),
             None => r,
         }
-    });
+    };
+    let paper = t.paper.as_ref().map(|p| with_rmse(&p.scores));
+    let paper_observed =
+        t.paper.as_ref().map(|p| with_rmse(p.observed.as_ref().unwrap_or(&p.scores)));
     let ceiling = t.ceiling.as_ref().map(|c| images(base.clone(), c));
     let point = |steps: u64, seconds: f64, psnr: f64, rmse: Option<f64>| {
         let p = base
@@ -178,6 +185,7 @@ pub fn read_run(dir: &Path) -> Result<Option<CollectedRun>> {
         noise_free,
         ceiling,
         paper,
+        paper_observed,
         curve,
         stop_reason: m.stop_reason,
     }))
@@ -267,7 +275,10 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
         let noise_free: Vec<RunRecord> =
             table_runs.iter().filter_map(|r| r.noise_free.clone()).collect();
         let paper: Vec<RunRecord> = table_runs.iter().filter_map(|r| r.paper.clone()).collect();
-        let mut tables = result_tables(&rec, &noise_free, &paper, &ceiling, profile);
+        let observed: Vec<RunRecord> =
+            table_runs.iter().filter_map(|r| r.paper_observed.clone()).collect();
+        let protocols = Protocols { noise_free: &noise_free, paper: &paper, observed: &observed };
+        let mut tables = result_tables(&rec, &protocols, &ceiling, profile);
         let table1_runs: Vec<&CollectedRun> = table_runs
             .iter()
             .copied()
@@ -284,7 +295,7 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
         }
         write_tables(&tables, out, &mut all_md, &mut summary)?;
         all_tables.extend(tables);
-        let c = report::paper::compare(&paper, &rec, profile)
+        let c = report::paper::compare(&paper, &observed, &rec, profile)
             .map_err(|e| Error::format(Path::new("crates/report/data/paper"), e.to_string()))?;
         let md = c.to_markdown();
         write(
@@ -329,22 +340,36 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
     Ok(summary)
 }
 
+/// The records of the runs under the other protocols than ours.
+struct Protocols<'a> {
+    /// On the mask, against the noise-free renders.
+    noise_free: &'a [RunRecord],
+    /// The paper's protocol: the whole frame against the noise-free renders.
+    paper: &'a [RunRecord],
+    /// The paper's whole frame against the observations, background set to 0.
+    observed: &'a [RunRecord],
+}
+
 /// Every result table of the runs (not the run-time one), with its file stem: `rec` under our
-/// protocol, `noise_free` on the mask against the noise-free renders, `paper` under the paper's
-/// protocol.
+/// protocol, the others from `protocols`.
 fn result_tables(
     rec: &[RunRecord],
-    noise_free: &[RunRecord],
-    paper: &[RunRecord],
+    protocols: &Protocols<'_>,
     ceiling: &[RunRecord],
     profile: &str,
 ) -> Vec<(String, Table)> {
+    let (noise_free, paper) = (protocols.noise_free, protocols.paper);
     let mut tables: Vec<(String, Table)> =
         vec![("table1".into(), report::table1(rec, ceiling, profile))];
     if !paper.is_empty() {
-        tables.push(("table1-paper".into(), report::table1_paper(paper, profile)));
+        let t = report::table1_paper(paper, Protocol::Paper, profile);
+        tables.push(("table1-paper".into(), t));
     }
+    // The reading against the observations differs from the paper's protocol only where a
+    // noise-free render exists.
     if !noise_free.is_empty() {
+        let t = report::table1_paper(protocols.observed, Protocol::PaperObserved, profile);
+        tables.push(("table1-paper-observed".into(), t));
         tables.push(("table1-noise-free".into(), report::table1_noise_free(noise_free, profile)));
     }
     tables.extend([

@@ -67,7 +67,11 @@ pub struct Tables<'a> {
 
 /// The index's sections: (heading, anchor, table stems in order).
 const SECTIONS: [(&str, &str, &[&str]); 4] = [
-    ("Table 1", "table1", &["table1", "table1-paper", "table1-noise-free"]),
+    (
+        "Table 1",
+        "table1",
+        &["table1", "table1-paper", "table1-paper-observed", "table1-noise-free"],
+    ),
     (
         "Ablations and analyses",
         "ablations",
@@ -198,7 +202,11 @@ fn paper_section(index: &mut Page, c: &PaperComparison) {
     index.heading("The paper beside ours", "paper");
     index.paragraph(report::Protocol::Paper.caption(), true);
     index.paragraph(&c.source_note(), true);
-    for l in c.level_lines() {
+    for l in PaperComparison::level_lines(&c.level) {
+        index.paragraph(&plain(&l), false);
+    }
+    index.paragraph(report::Protocol::PaperObserved.caption(), true);
+    for l in PaperComparison::level_lines(&c.level_observed) {
         index.paragraph(&plain(&l), false);
     }
     for (_, t) in &c.tables {

@@ -25,8 +25,11 @@ pub struct PaperComparison {
     pub profile: String,
     /// Transcribed cells of the paper's tables, and all of them (see the data README).
     pub transcribed: (usize, usize),
-    /// Our level of each group of rows against the paper's.
+    /// Our level of each group of rows against the paper's, under its protocol (against the
+    /// noise-free renders).
     pub level: Vec<LevelCheck>,
+    /// The same under its reading against the observations (background set to 0).
+    pub level_observed: Vec<LevelCheck>,
     /// Ours beside the paper's Table 1, one table per data set we ran that the paper has.
     pub tables: Vec<(String, Table)>,
     /// The ranking agreement of each column of Table 1's MERL half.
@@ -38,9 +41,11 @@ pub struct PaperComparison {
 }
 
 /// The comparison of our runs with the paper: `paper` holds the records under the paper's
-/// protocol (with RMSE∛), `ours` those under ours (with the reciprocity and energy analyses).
+/// protocol (with RMSE∛), `observed` under its reading against the observations, `ours` those
+/// under ours (with the reciprocity and energy analyses).
 pub fn compare(
     paper: &[RunRecord],
+    observed: &[RunRecord],
     ours: &[RunRecord],
     profile: &str,
 ) -> Result<PaperComparison, DataError> {
@@ -72,6 +77,7 @@ pub fn compare(
         profile: profile.to_string(),
         transcribed,
         level: compare::level(paper, &data::ranges()?, &merl),
+        level_observed: compare::level(observed, &data::ranges()?, &merl),
         tables,
         agreement: compare::agreement(paper, &merl),
         findings: findings::findings(paper, ours),
@@ -96,9 +102,9 @@ impl PaperComparison {
         s
     }
 
-    /// One line per level check.
-    pub fn level_lines(&self) -> Vec<String> {
-        self.level
+    /// One line per level check of `checks` (`level` or `level_observed`).
+    pub fn level_lines(checks: &[LevelCheck]) -> Vec<String> {
+        checks
             .iter()
             .map(|c| {
                 let r = &c.range;
@@ -157,8 +163,12 @@ impl PaperComparison {
             Protocol::Paper.caption(),
             self.source_note()
         );
-        s += "## Level\n\n";
-        for l in self.level_lines() {
+        s += "## Level\n\nThe paper's protocol (against the noise-free renders):\n\n";
+        for l in Self::level_lines(&self.level) {
+            s += &format!("* {l}\n");
+        }
+        s += &format!("\n{}\n\n", Protocol::PaperObserved.caption());
+        for l in Self::level_lines(&self.level_observed) {
             s += &format!("* {l}\n");
         }
         for (_, t) in &self.tables {
@@ -194,13 +204,13 @@ mod tests {
                 RunRecord::new(m, Dataset::MerlNbrdf, "spot").with_value(MetricKind::Psnr, 50.0)
             })
             .collect();
-        let c = compare(&paper, &paper, "default").unwrap();
+        let c = compare(&paper, &paper, &paper, "default").unwrap();
         assert_eq!(c.tables.len(), 1);
         assert!(c.missing[0].contains("DiLiGenT-MV") && c.missing[0].contains("fetch-data"));
         let md = c.to_markdown();
         assert!(md.contains("The paper's protocol"), "{md}");
         assert!(md.contains("## Ranking agreement") && md.contains("## The paper's findings"));
         assert_eq!(c.findings.len(), 6);
-        assert_eq!(c.level.len(), 2);
+        assert_eq!((c.level.len(), c.level_observed.len()), (2, 2));
     }
 }
