@@ -7,6 +7,7 @@
 //! (resuming from the last checkpoint) and evaluates it. A killed sweep therefore resumes with
 //! nothing lost but the steps since the last checkpoint.
 
+use super::heartbeat::Heartbeat;
 use super::plan::{self, Purpose, RunInfo, RunSpec, SceneSource, SceneSpec};
 use super::profile::{CaptureSource, SweepProfile, resolve_mesh};
 use crate::config::SpatialKind;
@@ -254,13 +255,25 @@ pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) ->
     let todo: Vec<&PathBuf> = dirs.iter().filter(|d| !is_done(d)).collect();
     summary.skipped = dirs.len() - todo.len();
     let bar = stdx::progress::bar(todo.len() as u64, "runs", "sweep", true);
+    let lines = match how {
+        Execution::InProcess(_) => Heartbeat::start(todo.len(), 1),
+        Execution::Children { jobs, .. } => Heartbeat::start(todo.len(), *jobs),
+        Execution::Emit { .. } => Heartbeat::start(0, 1),
+    };
     match how {
         Execution::InProcess(backend) => {
             for d in &todo {
                 bar.set_message(short(d));
+                lines.started(d);
                 match bar.suspend(|| run_one(d, true, *backend)) {
-                    Ok(()) => summary.completed += 1,
-                    Err(e) => summary.failed.push(((*d).clone(), e.to_string())),
+                    Ok(()) => {
+                        summary.completed += 1;
+                        lines.finished(d, true);
+                    }
+                    Err(e) => {
+                        summary.failed.push(((*d).clone(), e.to_string()));
+                        lines.finished(d, false);
+                    }
                 }
                 bar.inc(1);
             }
@@ -285,6 +298,7 @@ pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) ->
                         .stderr(err)
                         .spawn()
                         .map_err(|e| Error::io(Path::new(program), e))?;
+                    lines.started(d);
                     running.push(((*d).clone(), child));
                 }
                 if running.is_empty() {
@@ -297,7 +311,9 @@ pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) ->
                         running[i].1.try_wait().map_err(|e| Error::io(&running[i].0, e))?
                     {
                         let (d, _) = running.swap_remove(i);
-                        if status.success() && is_done(&d) {
+                        let ok = status.success() && is_done(&d);
+                        lines.finished(&d, ok);
+                        if ok {
                             summary.completed += 1;
                         } else {
                             let log = RunDir::new(&d).log();

@@ -1,17 +1,22 @@
 //! Sweeps: the whole reproduction (`cargo xtask reproduce-tables`) and `collect`.
 //!
-//! * [`profile`]: the sweep profiles (`smoke`, `quick`, `runtime`, `full`, or a TOML file).
+//! * [`profile`]: the sweep profiles (`default`, `smoke`, `quick`, `runtime`, `full`, `real`,
+//!   or a TOML file).
 //! * [`plan`]: scenes and runs of a profile, content-addressed run directories.
 //! * [`execute`]: scene generation, shared LBO tables, runs in-process, as child processes
 //!   (`--jobs`) or as a job file for a cluster (`--emit-jobs`).
 //! * [`collect`](mod@collect): tables (Markdown + LaTeX) and figures (PNG) from any set of run directories.
 //! * [`brdf_figures`]: the BRDF plots of `collect` (lit spheres, slices, albedo, validity).
 //! * [`html_report`]: the HTML report `collect` writes beside them.
+//! * [`heartbeat`]: plain progress lines when the output goes to a file.
+//! * The profiles (`smoke`, `quick`, `runtime`, `full`, `real`, or a TOML file) mix generated
+//!   scenes and real captures (imported from DiLiGenT and DiLiGenT-MV).
 //!
 //! Layout of a sweep's output directory:
 //!
 //! ```text
 //! <out>/scenes/<mesh>__<material>/   generated scenes (kept when complete)
+//! <out>/scenes/<object>/             imported captures (kept when complete)
 //! <out>/cache/                       LBO eigenpairs and feature tables
 //! <out>/runs/<object>__<model>__<options>__<steps>__<id>/   one run (config, weights, metrics,
 //!                                    renders, FLIP maps, run.json)
@@ -21,6 +26,7 @@
 pub mod brdf_figures;
 pub mod collect;
 pub mod execute;
+pub mod heartbeat;
 pub mod html_report;
 pub mod plan;
 pub mod profile;

@@ -1,0 +1,219 @@
+//! Plain progress lines for logs. A sweep's progress bars (indicatif) draw only on a terminal;
+//! run with its output in a file (CI, Slurm, nohup) a sweep would print nothing for the hour
+//! its runs train. When stderr is not a terminal, a [`Heartbeat`] prints a line when a run
+//! ends and at least every 30 seconds in between: runs done of the total, each running run with
+//! its last checkpointed step, the time elapsed and an estimate of the time left.
+//!
+//! ```text
+//! sweep: 5/27 runs done; running spot__brass__disney__default (step 1200), spot__brass__ts__default (step 400); 12.3 min elapsed, about 31 min left
+//! ```
+//!
+//! `NEURAL_BRDF_PROGRESS_LINES=1` prints them on a terminal too (`0`: never);
+//! `NEURAL_BRDF_PROGRESS_SECS` sets the interval (default 30).
+
+use crate::run_dir::RunDir;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// What the lines report.
+struct State {
+    total: usize,
+    jobs: usize,
+    done: usize,
+    failed: usize,
+    running: Vec<PathBuf>,
+    /// Wall seconds of each run finished in this sweep.
+    seconds: Vec<f64>,
+    started: Vec<(PathBuf, Instant)>,
+    start: Instant,
+    last_line: Instant,
+}
+
+/// Prints the progress lines of a sweep's runs while it lives (see the module doc).
+pub struct Heartbeat {
+    state: Option<Arc<Mutex<State>>>,
+    stop: Arc<AtomicBool>,
+    thread: Option<JoinHandle<()>>,
+}
+
+impl Heartbeat {
+    /// Starts the lines for `total` runs, `jobs` at a time (nothing when they are not wanted).
+    pub fn start(total: usize, jobs: usize) -> Self {
+        let stop = Arc::new(AtomicBool::new(false));
+        if !lines_wanted() || total == 0 {
+            return Heartbeat { state: None, stop, thread: None };
+        }
+        let now = Instant::now();
+        let state = Arc::new(Mutex::new(State {
+            total,
+            jobs: jobs.max(1),
+            done: 0,
+            failed: 0,
+            running: Vec::new(),
+            seconds: Vec::new(),
+            started: Vec::new(),
+            start: now,
+            last_line: now,
+        }));
+        let every = interval();
+        let (s, flag) = (Arc::clone(&state), Arc::clone(&stop));
+        let thread = std::thread::spawn(move || {
+            while !flag.load(Ordering::Relaxed) {
+                std::thread::sleep(Duration::from_millis(200).min(every));
+                let mut st = s.lock().unwrap_or_else(PoisonError::into_inner);
+                if st.last_line.elapsed() >= every {
+                    eprintln!("{}", line(&st));
+                    st.last_line = Instant::now();
+                }
+            }
+        });
+        Heartbeat { state: Some(state), stop, thread: Some(thread) }
+    }
+
+    fn with(&self, f: impl FnOnce(&mut State)) {
+        if let Some(s) = &self.state {
+            f(&mut s.lock().unwrap_or_else(PoisonError::into_inner));
+        }
+    }
+
+    /// A run started.
+    pub fn started(&self, run: &Path) {
+        self.with(|st| {
+            st.running.push(run.to_path_buf());
+            st.started.push((run.to_path_buf(), Instant::now()));
+        });
+    }
+
+    /// A run ended (`ok`: evaluated); prints a line.
+    pub fn finished(&self, run: &Path, ok: bool) {
+        self.with(|st| {
+            st.running.retain(|r| r != run);
+            if let Some(i) = st.started.iter().position(|(r, _)| r == run) {
+                let (_, t) = st.started.swap_remove(i);
+                st.seconds.push(t.elapsed().as_secs_f64());
+            }
+            st.done += 1;
+            if !ok {
+                st.failed += 1;
+            }
+            let what = if ok { "finished" } else { "failed" };
+            eprintln!("sweep: {} {what}", name(run));
+            eprintln!("{}", line(st));
+            st.last_line = Instant::now();
+        });
+    }
+}
+
+impl Drop for Heartbeat {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+/// Whether to print the lines: `NEURAL_BRDF_PROGRESS_LINES` (1 or 0), else when stderr is not a
+/// terminal.
+fn lines_wanted() -> bool {
+    match std::env::var("NEURAL_BRDF_PROGRESS_LINES").as_deref() {
+        Ok("1") => true,
+        Ok("0") => false,
+        _ => !std::io::stderr().is_terminal(),
+    }
+}
+
+/// `NEURAL_BRDF_PROGRESS_SECS`, default 30 s, at least 1 s.
+fn interval() -> Duration {
+    let secs = std::env::var("NEURAL_BRDF_PROGRESS_SECS")
+        .ok()
+        .and_then(|v| v.parse::<u64>().ok())
+        .unwrap_or(30)
+        .max(1);
+    Duration::from_secs(secs)
+}
+
+/// A run directory's name without its step budget and id.
+fn name(run: &Path) -> String {
+    let n = run.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let parts: Vec<&str> = n.split("__").collect();
+    if parts.len() > 2 { parts[..parts.len() - 2].join("__") } else { n }
+}
+
+/// The step of a run's last checkpoint (the last row of its `curve.csv`).
+fn last_step(run: &Path) -> Option<u64> {
+    let text = std::fs::read_to_string(RunDir::new(run).curve()).ok()?;
+    text.lines().last()?.split(',').next()?.trim().parse().ok()
+}
+
+fn minutes(s: f64) -> String {
+    if s < 90.0 { format!("{s:.0} s") } else { format!("{:.1} min", s / 60.0) }
+}
+
+fn line(st: &State) -> String {
+    let mut s = format!("sweep: {}/{} runs done", st.done, st.total);
+    if st.failed > 0 {
+        s += &format!(", {} failed", st.failed);
+    }
+    if !st.running.is_empty() {
+        let running: Vec<String> = st
+            .running
+            .iter()
+            .map(|r| match last_step(r) {
+                Some(step) => format!("{} (step {step})", name(r)),
+                None => format!("{} (starting)", name(r)),
+            })
+            .collect();
+        s += &format!("; running {}", running.join(", "));
+    }
+    let elapsed = st.start.elapsed().as_secs_f64();
+    s += &format!("; {} elapsed", minutes(elapsed));
+    let left = st.total - st.done;
+    if left > 0 && !st.seconds.is_empty() {
+        let mean = st.seconds.iter().sum::<f64>() / st.seconds.len() as f64;
+        let running: f64 =
+            st.started.iter().map(|(_, t)| t.elapsed().as_secs_f64().min(mean)).sum();
+        let estimate = ((left as f64 * mean - running) / st.jobs as f64).max(0.0);
+        s += &format!(", about {} left", minutes(estimate));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_name_the_runs_their_steps_and_the_time_left() {
+        let tmp = test_support::TempDir::new("heartbeat");
+        let run = tmp.0.join("spot__brass__disney__default__6000__0123456789abcdef");
+        std::fs::create_dir_all(&run).unwrap();
+        let now = Instant::now();
+        let mut st = State {
+            total: 4,
+            jobs: 2,
+            done: 1,
+            failed: 0,
+            running: vec![run.clone()],
+            seconds: vec![120.0],
+            started: vec![(run.clone(), now)],
+            start: now,
+            last_line: now,
+        };
+        let l = line(&st);
+        assert!(
+            l.starts_with("sweep: 1/4 runs done; running spot__brass__disney__default (starting)"),
+            "{l}"
+        );
+        // 3 runs left at 120 s, 2 at a time, the running one just begun: about 3 min.
+        assert!(l.contains("about 3.0 min left"), "{l}");
+        std::fs::write(RunDir::new(&run).curve(), "step,loss\n250,0.1\n500,0.05\n").unwrap();
+        st.failed = 1;
+        let l = line(&st);
+        assert!(l.contains("(step 500)") && l.contains(", 1 failed"), "{l}");
+    }
+}
