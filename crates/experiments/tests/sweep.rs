@@ -244,6 +244,22 @@ fn the_smoke_profile_runs_end_to_end() {
     assert!(run_html.contains("computed (the paper"), "the paper's protocol on the run page");
     assert!(html.contains("The paper beside ours") && html.contains("Kendall"), "{html}");
     assert!(run_html.contains("pixels per degree") && run_html.contains("-curve-steps.png"));
+    // A collect missing one run: the model's means cover one object fewer than the others',
+    // so they print with a dagger, take no mark, and the legend names the missing object.
+    let dropped = |d: &PathBuf| {
+        let n = d.file_name().unwrap().to_string_lossy().into_owned();
+        n.starts_with("spot__gold-metallic-paint__additive_separate__default__")
+    };
+    assert_eq!(s.runs.iter().filter(|d| dropped(d)).count(), 1);
+    let kept: Vec<PathBuf> = s.runs.iter().filter(|d| !dropped(d)).cloned().collect();
+    let partial = tmp.0.join("partial");
+    sweep::collect(&kept, &partial, "smoke").unwrap();
+    let t1 = std::fs::read_to_string(partial.join("tables/table1.md")).unwrap();
+    let row = t1.lines().find(|l| l.starts_with("| Add. Sep. |")).unwrap();
+    assert!(row.contains('†') && !row.contains("**") && !row.contains("<u>"), "{row}");
+    assert!(t1.contains("Add. Sep. without spot__gold-metallic-paint"), "{t1}");
+    let tex = std::fs::read_to_string(partial.join("tables/table1.tex")).unwrap();
+    assert!(tex.contains("\\dagger"), "{tex}");
     browser_check(&index, "smoke-report-index");
     browser_check(&pages[0], "smoke-report-run");
 }

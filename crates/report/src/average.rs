@@ -75,7 +75,9 @@ pub fn per_object(
 }
 
 /// The table value of `metric` for (model, options, dataset): the mean over objects of the
-/// per-object means, [`Cell::NotRun`] when nothing was measured.
+/// per-object means, [`Cell::NotRun`] when nothing was measured, and [`Cell::Partial`] when
+/// the records hold objects of `dataset` that (model, options) was not measured on: such a mean
+/// is not comparable with the other rows'.
 pub fn average(
     records: &[&RunRecord],
     model: ModelKind,
@@ -85,12 +87,20 @@ pub fn average(
 ) -> Cell {
     match per_object(records, model, options, dataset, metric) {
         None => Cell::NotRun,
-        Some(objects) => {
+        Some(measured) => {
             let mut mean = PerObjectMean::new();
-            for (object, score) in objects {
-                mean.push(&object, score);
+            for (object, score) in &measured {
+                mean.push(object, score.clone());
             }
-            Cell::Score(mean.overall())
+            let missing: Vec<String> = objects(records, dataset)
+                .into_iter()
+                .filter(|o| !measured.contains_key(o))
+                .collect();
+            if missing.is_empty() {
+                Cell::Score(mean.overall())
+            } else {
+                Cell::Partial(mean.overall(), missing)
+            }
         }
     }
 }
@@ -134,6 +144,23 @@ mod tests {
 
     fn rec(model: ModelKind, object: &str, psnr: f64) -> RunRecord {
         RunRecord::new(model, Dataset::MerlNbrdf, object).with_value(MetricKind::Psnr, psnr)
+    }
+
+    #[test]
+    fn a_mean_over_fewer_objects_than_the_others_is_partial() {
+        let records = [
+            rec(ModelKind::Disney, "bear", 30.0),
+            rec(ModelKind::Disney, "cow", 20.0),
+            rec(ModelKind::Rp, "cow", 99.0),
+        ];
+        let all: Vec<&RunRecord> = records.iter().collect();
+        let d = Dataset::MerlNbrdf;
+        let o = RunOptions::DEFAULT;
+        assert_eq!(average(&all, ModelKind::Disney, o, &d, MetricKind::Psnr), Cell::value(25.0));
+        assert_eq!(
+            average(&all, ModelKind::Rp, o, &d, MetricKind::Psnr),
+            Cell::Partial(Score::Value(99.0), vec!["bear".into()])
+        );
     }
 
     #[test]

@@ -136,6 +136,7 @@ fn escape(s: &str, abbreviations: bool) -> String {
             '↓' => out.push_str("\\ensuremath{\\downarrow}"),
             '∛' => out.push_str("\\ensuremath{^{\\sqrt[3]{}}}"),
             'Δ' => out.push_str("\\ensuremath{\\Delta}"),
+            '†' => out.push_str("\\ensuremath{^\\dagger}"),
             '−' => out.push_str("\\ensuremath{-}"),
             '–' => out.push_str("--"),
             '×' => out.push_str("\\ensuremath{\\times}"),

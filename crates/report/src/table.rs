@@ -3,7 +3,9 @@
 //!
 //! Cells print as the scaled value with the column's decimals, `n/a` for a metric that could
 //! not be computed (the reasons are listed below the table), and `–` for a combination that
-//! was not run. Which cells are highlighted follows [`Marking`] (see [`super::rank`]).
+//! was not run. A mean over fewer objects than the table's other rows prints with a `†`, is
+//! never marked, and the legend names the objects it lacks. Which cells are highlighted
+//! follows [`Marking`] (see [`super::rank`]).
 
 use super::rank::{Mark, improvements, rank};
 use super::record::{Direction, MetricKind};
@@ -16,7 +18,13 @@ pub enum Cell {
     Score(Score),
     /// The combination was not run (printed `–`).
     NotRun,
+    /// A mean over fewer objects than the table's other rows (printed with `†`, never
+    /// marked): its score and the objects it lacks.
+    Partial(Score, Vec<String>),
 }
+
+/// The mark of a [`Cell::Partial`].
+pub const PARTIAL_MARK: &str = "†";
 
 impl Cell {
     /// A cell holding the value `v`.
@@ -189,7 +197,34 @@ impl Table {
             Cell::NotRun => "–".into(),
             Cell::Score(Score::Unavailable(_)) => "n/a".into(),
             Cell::Score(Score::Value(v)) => col.format(*v),
+            Cell::Partial(Score::Value(v), _) => format!("{}{PARTIAL_MARK}", col.format(*v)),
+            Cell::Partial(Score::Unavailable(_), _) => format!("n/a{PARTIAL_MARK}"),
         }
+    }
+
+    /// The partial cells' lines for the legend: "<row> <column> (without a, b)", grouped by
+    /// row and missing objects.
+    fn partial_notes(&self) -> Vec<String> {
+        let columns = self.columns();
+        let mut notes: Vec<(String, Vec<String>, Vec<String>)> = Vec::new();
+        for row in &self.rows {
+            for (c, cell) in row.cells.iter().enumerate() {
+                let Cell::Partial(_, missing) = cell else { continue };
+                let column = columns.get(c).map_or(String::new(), |c| c.label.clone());
+                match notes.iter_mut().find(|(r, m, _)| *r == row.label && m == missing) {
+                    Some((_, _, cols)) => {
+                        if !cols.contains(&column) {
+                            cols.push(column)
+                        }
+                    }
+                    None => notes.push((row.label.clone(), missing.clone(), vec![column])),
+                }
+            }
+        }
+        notes
+            .into_iter()
+            .map(|(row, missing, _)| format!("{row} without {}", missing.join(", ")))
+            .collect()
     }
 
     /// The mark of every cell, `[row][column]`.
@@ -235,7 +270,8 @@ impl Table {
         let mut reasons: Vec<String> = Vec::new();
         for row in &self.rows {
             for cell in &row.cells {
-                if let Cell::Score(Score::Unavailable(why)) = cell
+                if let Cell::Score(Score::Unavailable(why))
+                | Cell::Partial(Score::Unavailable(why), _) = cell
                     && !reasons.contains(why)
                 {
                     reasons.push(why.clone());
@@ -273,6 +309,14 @@ impl Table {
         }
         if self.has_not_run() {
             parts.push("– not run".into());
+        }
+        let partial = self.partial_notes();
+        if !partial.is_empty() {
+            parts.push(format!(
+                "{PARTIAL_MARK} a mean over fewer objects than the other rows, left out of the \
+                 marks ({})",
+                partial.join("; ")
+            ));
         }
         let reasons = self.unavailable_reasons();
         if !reasons.is_empty() {
@@ -384,6 +428,26 @@ mod tests {
         assert_eq!(t.cell_text(3, 1), "–");
         assert_eq!(t.cell_text(2, 0), "n/a");
         assert_eq!(t.unavailable_reasons(), vec!["x".to_string()]);
+    }
+
+    #[test]
+    fn partial_means_print_a_dagger_and_are_never_marked() {
+        let t = table(
+            Marking::RankColumns,
+            vec![
+                vec![Cell::value(30.0), Cell::value(0.1)],
+                vec![Cell::Partial(Score::Value(41.0), vec!["steel".into()]), Cell::value(0.2)],
+                vec![Cell::value(29.0), Cell::value(0.3)],
+            ],
+        );
+        assert_eq!(t.cell_text(1, 0), "41.00†");
+        let m = t.marks();
+        // The partial mean is the highest but takes no mark: 30 is best, 29 second.
+        assert_eq!((m[0][0], m[1][0], m[2][0]), (Mark::First, Mark::None, Mark::Second));
+        let legend = t.legend(["b", "u", "i", "B"]);
+        assert!(
+            legend.contains("† a mean over fewer objects") && legend.contains("m1 without steel")
+        );
     }
 
     #[test]

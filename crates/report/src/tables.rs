@@ -414,7 +414,14 @@ pub fn per_object_table(
                 for (object, score) in p {
                     mean.push(object, score.clone());
                 }
-                Cell::Score(mean.overall())
+                // A column that lacks objects of the others has a mean over fewer objects.
+                let missing: Vec<String> =
+                    names.iter().filter(|o| !p.contains_key(*o)).cloned().collect();
+                if missing.is_empty() {
+                    Cell::Score(mean.overall())
+                } else {
+                    Cell::Partial(mean.overall(), missing)
+                }
             }
         })
         .collect();
