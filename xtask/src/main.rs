@@ -2,7 +2,8 @@
 //!
 //! Every user-facing job of the workspace is a subcommand here; run `cargo xtask --help`.
 //! The main job is `reproduce-tables` (the paper's tables and figures from one command, see
-//! `docs/reproduce.md`); `collect` rebuilds them from any run directories, `fetch-data`
+//! `docs/reproduce.md`); `collect` rebuilds them from any run directories, `publish-tables`
+//! copies a run's tables into the documents, `fetch-data`
 //! downloads the real datasets, `import-diligent` turns a DiLiGenT capture into a scene,
 //! `import-capture` a user's own (docs/capture-format.md).
 
@@ -12,6 +13,7 @@ mod fetch;
 mod generate_scenes;
 mod import_diligent;
 mod layers;
+mod publish;
 mod reproduce;
 
 use anyhow::Result;
@@ -145,6 +147,13 @@ enum Command {
         #[arg(long, default_value = "collected")]
         profile: String,
     },
+    /// Copy a sweep's tables into the generated blocks of README.md and docs/reproduce.md
+    /// (each block names its tables; runs of another results version are refused).
+    PublishTables {
+        /// The sweep's output directory (holding runs/ and tables/).
+        #[arg(default_value = "out/reproduce")]
+        out: PathBuf,
+    },
     /// Fit (resuming) and evaluate one prepared run directory: what `--jobs` children and
     /// `--emit-jobs` lines run.
     RunOne {
@@ -271,6 +280,9 @@ fn main() -> Result<()> {
             })?;
         }
         Command::Collect { paths, out, profile } => reproduce::collect(&paths, &out, &profile)?,
+        Command::PublishTables { out } => {
+            publish::run(&out, &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))?
+        }
         Command::RunOne { run, quiet, backend } => reproduce::run_one(&run, !quiet, backend)?,
         Command::ImportDiligent { src, out, train_lights, test_lights, target_vertices } => {
             import_diligent::run(&src, &out, train_lights, test_lights, target_vertices)?;
