@@ -9,13 +9,14 @@
 //! table columns are masked, and the run-time table, its plots and the HTML report, which are
 //! about time, are skipped), and no temporary file is left anywhere.
 //!
-//! A second test runs a sweep on a 3 MiB tmpfs (a user namespace; skipped where `unshare`
-//! cannot mount one): the full disk must end the sweep with an error that says so and names a
-//! file, and the results already there must be unchanged.
-//!
-//! Both take minutes, so they are `#[ignore]`d:
+//! CI runs a cheap version on every run: a tiny sweep (one 24 px scene, two models) killed 5
+//! times. The 20-kill version on the larger sweep takes minutes and is opt-in:
 //! `cargo test -p xtask --test kill_torture -- --ignored --nocapture`
-//! (`NEURAL_BRDF_TORTURE_KILLS` sets the number of kills, 20 by default).
+//! (`NEURAL_BRDF_TORTURE_KILLS` sets the number of kills of either).
+//!
+//! A third test runs a sweep on a 3 MiB tmpfs (a user namespace; skipped, saying why, where
+//! `unshare` cannot mount one): the full disk must end the sweep with an error that says so and
+//! names a file, and the results already there must be unchanged.
 
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -58,6 +59,42 @@ reciprocity_pairs = 200
 models = ["rp", "disney", "single_mlp", "additive_shared_enhanced"]
 ablations = ["nol"]
 runtime_curve = true
+"#;
+
+/// The cheap torture of every CI run: one tiny scene, two models, the NOL ablation.
+const TINY: &str = r#"
+name = "tiny-torture"
+description = "kill -9 torture in CI: one tiny scene, two models"
+[data]
+meshes = ["embedded:spot"]
+materials = ["blue-acrylic"]
+size = 24
+views = 2
+lights = 4
+[run]
+seed = 3
+[run.model]
+width = 16
+[run.features.lbo]
+k_max = 32
+first = 16
+blocks = 1
+block_len = 8
+[run.train]
+profile = "quick"
+iterations = 60
+batch_size = 512
+warmup_steps = 5
+checkpoint_every = 10
+log_every = 5
+validate_every = 10
+patience = 20
+[run.eval]
+energy_pairs = 4
+reciprocity_pairs = 200
+[sweep]
+models = ["disney", "single_mlp"]
+ablations = ["nol"]
 "#;
 
 /// A small deterministic generator (xorshift64*).
@@ -302,14 +339,28 @@ fn wait_for_children(out: &Path) -> Duration {
     t.elapsed()
 }
 
+/// The number of kills: `NEURAL_BRDF_TORTURE_KILLS`, else `default`.
+fn kills(default: usize) -> usize {
+    std::env::var("NEURAL_BRDF_TORTURE_KILLS").ok().and_then(|v| v.parse().ok()).unwrap_or(default)
+}
+
+#[test]
+fn a_tiny_sweep_killed_five_times_resumes_to_the_same_results() {
+    torture(TINY, "tiny-torture", kills(5));
+}
+
 #[test]
 #[ignore = "minutes: cargo test -p xtask --test kill_torture -- --ignored --nocapture"]
 fn a_sweep_killed_at_random_moments_resumes_to_the_same_results() {
-    let kills: usize =
-        std::env::var("NEURAL_BRDF_TORTURE_KILLS").ok().and_then(|v| v.parse().ok()).unwrap_or(20);
-    let tmp = test_support::TempDir::new("torture");
+    torture(PROFILE, "torture", kills(20));
+}
+
+/// Runs the sweep of `profile_text` once uninterrupted, then `kills` times killed at random
+/// moments and resumed, and compares (see the module doc).
+fn torture(profile_text: &str, label: &str, kills: usize) {
+    let tmp = test_support::TempDir::new(label);
     let profile = tmp.0.join("torture.toml");
-    std::fs::write(&profile, PROFILE).unwrap();
+    std::fs::write(&profile, profile_text).unwrap();
     let (clean, log) = (tmp.0.join("clean"), tmp.0.join("log.txt"));
     let t = Instant::now();
     let status = start(&profile, &clean, 1, &log).wait().unwrap();
@@ -387,7 +438,6 @@ fn a_sweep_killed_at_random_moments_resumes_to_the_same_results() {
 }
 
 #[test]
-#[ignore = "needs user namespaces (unshare -rm): cargo test -p xtask --test kill_torture -- --ignored"]
 fn a_full_disk_is_a_clear_error_and_keeps_the_previous_results() {
     let tmp = test_support::TempDir::new("fulldisk");
     let profile = tmp.0.join("torture.toml");
