@@ -242,8 +242,8 @@ pub fn table1_paper(records: &[RunRecord], protocol: Protocol, profile: &str) ->
                  image, then per object, then over objects; DSSIM, LPIPS, FLIP and RMSE∛ ×100 \
                  (RMSE∛, in BRDF space, is the same in every protocol).{}",
                 protocol.caption(),
-                if protocol == Protocol::Paper {
-                    " An exact model scores ∞ dB here."
+                if protocol == Protocol::Paper && data.iter().any(Dataset::has_brdf_ground_truth) {
+                    " An exact model scores ∞ dB here on generated scenes."
                 } else {
                     ""
                 }
@@ -290,6 +290,8 @@ fn ceiling_gap(
         return Cell::NotRun;
     };
     let mut mean = PerObjectMean::new();
+    let missing: Vec<String> =
+        objects(records, dataset).into_iter().filter(|o| !ours.contains_key(o)).collect();
     for (object, score) in ours {
         let mine: Vec<&RunRecord> =
             ceiling.iter().copied().filter(|r| r.object == object).collect();
@@ -299,7 +301,11 @@ fn ceiling_gap(
         };
         mean.push(&object, score.value().map_or(score.clone(), |v| Score::Value(c - v)));
     }
-    if mean.per_object().is_empty() { Cell::NotRun } else { Cell::Score(mean.overall()) }
+    match (mean.per_object().is_empty(), missing.is_empty()) {
+        (true, _) => Cell::NotRun,
+        (false, true) => Cell::Score(mean.overall()),
+        (false, false) => Cell::Partial(mean.overall(), missing),
+    }
 }
 
 /// Reciprocity RMSE (not scaled) of every model under each reciprocity option: none, random
@@ -498,6 +504,8 @@ mod tests {
             run(ModelKind::Ts, "a", 40.0),
             run(ModelKind::Ts, "b", 30.0),
             run(ModelKind::SingleMlp, "a", 44.0),
+            run(ModelKind::Disney, "a", 20.0),
+            run(ModelKind::Disney, "b", 20.0),
         ];
         // The ceiling as every run of an object reports it (identical per object).
         let ceiling: Vec<RunRecord> = [("a", 45.0), ("a", 45.0), ("b", 41.0)]
@@ -515,11 +523,19 @@ mod tests {
         // Ceiling PSNR: (45 + 41) / 2; TS gap: ((45 - 40) + (41 - 30)) / 2; Single MLP: 45 - 44.
         assert_eq!(t.cell_text(last, 0), "43.00");
         assert_eq!(t.cell_text(1, gap), "8.00");
-        assert_eq!(t.cell_text(4, gap), "1.00");
+        // Single MLP ran on one of the two objects: its mean and gap are partial, unmarked.
+        assert_eq!(t.cell_text(4, 0), "44.00†");
+        assert_eq!(t.cell_text(4, gap), "1.00†");
         assert_eq!(t.cell_text(last, gap), "–");
-        // Never ranked: Single MLP is best in PSNR although the ceiling is higher.
-        assert_eq!(t.marks()[4][0], super::super::rank::Mark::First);
-        assert_eq!(t.marks()[last][0], super::super::rank::Mark::None);
+        // Never ranked: neither the partial row nor the ceiling, though both are higher than
+        // TS, which is best.
+        use super::super::rank::Mark;
+        assert_eq!(
+            (t.marks()[1][0], t.marks()[3][0], t.marks()[4][0]),
+            (Mark::First, Mark::Second, Mark::None)
+        );
+        assert_eq!(t.marks()[last][0], Mark::None);
+        assert!(to_markdown(&t).contains("Single MLP without b"));
         // The per-object table gets the ceiling as a last, unranked column.
         let p = per_object_table(&records, &ceiling, &d, MetricKind::Psnr, Protocol::Ours, "quick");
         assert_eq!(p.columns().last().unwrap().label, CEILING_LABEL);

@@ -158,8 +158,13 @@ pub fn read_run(dir: &Path) -> Result<Option<CollectedRun>> {
         }
     };
     let paper = t.paper.as_ref().map(|p| with_rmse(&p.scores));
-    let paper_observed =
-        t.paper.as_ref().map(|p| with_rmse(p.observed.as_ref().unwrap_or(&p.scores)));
+    // A capture's paper scores already are against its observations; a generated scene
+    // evaluated before the reading against the observations existed has none.
+    let paper_observed = t.paper.as_ref().and_then(|p| match (&p.observed, &t.clean) {
+        (Some(o), _) => Some(with_rmse(o)),
+        (None, None) => Some(with_rmse(&p.scores)),
+        (None, Some(_)) => None,
+    });
     let ceiling = t.ceiling.as_ref().map(|c| images(base.clone(), c));
     let point = |steps: u64, seconds: f64, psnr: f64, rmse: Option<f64>| {
         let p = base

@@ -221,7 +221,8 @@ fn paper_section(index: &mut Page, c: &PaperComparison) {
     }
     index.paragraph("The paper's findings on our runs:", false);
     for f in &c.findings {
-        index.paragraph(&format!("{}: {}. {}.", f.verdict(), f.claim, f.evidence), false);
+        let evidence = report::paper::sentence(&f.evidence);
+        index.paragraph(&format!("{}: {}. {evidence}.", f.verdict(), f.claim), false);
     }
 }
 

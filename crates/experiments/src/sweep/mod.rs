@@ -9,6 +9,7 @@
 //! * [`brdf_figures`]: the BRDF plots of `collect` (lit spheres, slices, albedo, validity).
 //! * [`html_report`]: the HTML report `collect` writes beside them.
 //! * [`heartbeat`]: plain progress lines when the output goes to a file.
+//! * [`sources`]: mesh sources (embedded in the binary, under the data root) and real captures.
 //! * The profiles (`smoke`, `quick`, `runtime`, `full`, `real`, or a TOML file) mix generated
 //!   scenes and real captures (imported from DiLiGenT and DiLiGenT-MV).
 //!
@@ -30,6 +31,7 @@ pub mod heartbeat;
 pub mod html_report;
 pub mod plan;
 pub mod profile;
+pub mod sources;
 
 pub use collect::{CollectSummary, collect};
 pub use execute::{Execution, SweepSummary, exit_with_parent, run_one, sweep};

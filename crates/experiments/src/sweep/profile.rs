@@ -32,11 +32,12 @@
 //!
 //! Every key is checked: unknown keys are errors that name the key and the file.
 
+pub use super::sources::{CaptureSource, mesh_name, resolve_mesh};
 use crate::{Error, Result};
 use brdf_neural::ModelKind;
 use brdf_neural::precision::MatmulPrecision;
 use serde::Deserialize;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The built-in profiles: (name, TOML text).
 pub const BUILT_IN: [(&str, &str); 6] = [
@@ -283,13 +284,25 @@ impl SweepProfile {
                 .map_err(|e| Error::config("data.captures", e))?
                 .find(data_root)?;
         }
+        // Missing optional captures of one benchmark make one note: (benchmark, names, error).
+        let mut missing: Vec<(&'static str, Vec<String>, String)> = Vec::new();
         for c in std::mem::take(&mut self.data.optional_captures) {
             let source =
                 CaptureSource::parse(&c).map_err(|e| Error::config("data.optional_captures", e))?;
             match source.find(data_root) {
                 Ok(_) => self.data.captures.push(c),
-                Err(e) => notes.push(format!("skipped {c}: {e}")),
+                Err(e) => {
+                    let kind = source.dataset(Path::new(""));
+                    match missing.iter_mut().find(|m| m.0 == kind) {
+                        Some(m) => m.1.push(c),
+                        None => missing.push((kind, vec![c], e.to_string())),
+                    }
+                }
             }
+        }
+        for (_, names, error) in missing {
+            let what = if names.len() > 1 { "optional captures" } else { "optional capture" };
+            notes.push(format!("skipped {} {what} ({}): {error}", names.len(), names.join(", ")));
         }
         Ok((self, notes))
     }
@@ -347,146 +360,6 @@ impl SweepProfile {
             })
             .collect()
     }
-}
-
-/// A real capture of a profile: `diligent:NAME` (a single-view DiLiGenT object, so far the
-/// ball), `diligent-mv:NAME` (a DiLiGenT-MV object: bear, buddha, cow, pot2, reading), or
-/// `data:PATH` / a path to a capture directory of either layout.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum CaptureSource {
-    /// A single-view DiLiGenT object.
-    Diligent(String),
-    /// A DiLiGenT-MV object.
-    DiligentMv(String),
-    /// A capture directory: under the data root (`data:`), or a path.
-    Path {
-        /// The path as written, without `data:`.
-        path: String,
-        /// Whether it is relative to the data root.
-        under_root: bool,
-    },
-}
-
-impl CaptureSource {
-    /// Parses a profile's capture entry.
-    pub fn parse(s: &str) -> std::result::Result<Self, String> {
-        let name = |n: &str| -> std::result::Result<String, String> {
-            if n.is_empty() || !n.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-                Err(format!("{s:?}: {n:?} is not an object name"))
-            } else {
-                Ok(n.to_string())
-            }
-        };
-        if let Some(n) = s.strip_prefix("diligent-mv:") {
-            Ok(CaptureSource::DiligentMv(name(n)?))
-        } else if let Some(n) = s.strip_prefix("diligent:") {
-            Ok(CaptureSource::Diligent(name(n)?))
-        } else if let Some(p) = s.strip_prefix("data:") {
-            Ok(CaptureSource::Path { path: p.to_string(), under_root: true })
-        } else if s.is_empty() {
-            Err("an empty capture entry".into())
-        } else {
-            Ok(CaptureSource::Path { path: s.to_string(), under_root: false })
-        }
-    }
-
-    /// The object's name (the scene's name in the sweep).
-    pub fn object(&self) -> String {
-        match self {
-            CaptureSource::Diligent(n) | CaptureSource::DiligentMv(n) => n.clone(),
-            CaptureSource::Path { path, .. } => {
-                let p = Path::new(path.trim_end_matches('/'));
-                let n = p.file_name().and_then(|n| n.to_str()).unwrap_or("capture");
-                n.strip_suffix("PNG").unwrap_or(n).to_string()
-            }
-        }
-    }
-
-    /// The directories it may be in, in the order they are tried: a benchmark's layout as the
-    /// shared data has it and as `cargo xtask fetch-data` unpacks its zip.
-    pub fn candidates(&self, data_root: &Path) -> Vec<PathBuf> {
-        match self {
-            CaptureSource::Diligent(n) => vec![
-                data_root.join(format!("diligent/pmsData/{n}PNG")),
-                data_root.join(format!("diligent/DiLiGenT/pmsData/{n}PNG")),
-            ],
-            CaptureSource::DiligentMv(n) => vec![
-                data_root.join(format!("diligent-mv/mvpmsData/{n}PNG")),
-                data_root.join(format!("diligent-mv/DiLiGenT-MV/mvpmsData/{n}PNG")),
-            ],
-            CaptureSource::Path { path, under_root: true } => vec![data_root.join(path)],
-            CaptureSource::Path { path, under_root: false } => vec![PathBuf::from(path)],
-        }
-    }
-
-    /// The capture's directory under `data_root`, or an error naming every place looked in
-    /// and how to get the data.
-    pub fn find(&self, data_root: &Path) -> Result<PathBuf> {
-        let candidates = self.candidates(data_root);
-        if let Some(dir) = candidates.iter().find(|d| d.is_dir()) {
-            return Ok(dir.clone());
-        }
-        let how = match self {
-            CaptureSource::Diligent(_) => {
-                "get DiLiGenT with `cargo xtask fetch-data diligent` (a zip downloaded by hand: \
-                 data-manifests/diligent.toml says from where), or point NEURAL_BRDF_DATA (or \
-                 --data) at a data root that has it"
-            }
-            CaptureSource::DiligentMv(_) => {
-                "get DiLiGenT-MV with `cargo xtask fetch-data diligent-mv` (a zip downloaded by \
-                 hand: data-manifests/diligent-mv.toml says from where), or point \
-                 NEURAL_BRDF_DATA (or --data) at a data root that has it"
-            }
-            CaptureSource::Path { .. } => "check the path",
-        };
-        let looked: Vec<String> = candidates.iter().map(|c| c.display().to_string()).collect();
-        Err(Error::format(
-            &candidates[0],
-            format!("capture not found (looked in {}); {how}", looked.join(" and ")),
-        ))
-    }
-
-    /// The data set label its runs carry.
-    pub fn dataset(&self, dir: &Path) -> &'static str {
-        match self {
-            CaptureSource::Diligent(_) => "DiLiGenT",
-            CaptureSource::DiligentMv(_) => "DiLiGenT-MV",
-            CaptureSource::Path { .. } if dir.join("view_01").is_dir() => "DiLiGenT-MV",
-            CaptureSource::Path { .. } => "DiLiGenT",
-        }
-    }
-}
-
-/// Resolves a mesh source: `embedded:NAME` -> the mesh shipped in `data-manifests/embedded/`,
-/// `data:PATH` -> `<data root>/PATH`, anything else a path.
-pub fn resolve_mesh(source: &str, data_root: &Path) -> Result<PathBuf> {
-    let path = if let Some(name) = source.strip_prefix("embedded:") {
-        embedded_dir().join(name).join(format!("{name}.obj"))
-    } else if let Some(rel) = source.strip_prefix("data:") {
-        data_root.join(rel)
-    } else {
-        PathBuf::from(source)
-    };
-    if !path.is_file() {
-        let hint = if source.starts_with("data:") {
-            " (fetch it with `cargo xtask fetch-data meshes`, or set NEURAL_BRDF_DATA)"
-        } else {
-            ""
-        };
-        return Err(Error::format(&path, format!("mesh {source} not found{hint}")));
-    }
-    Ok(path)
-}
-
-/// The directory of the meshes shipped with the repository.
-pub fn embedded_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data-manifests/embedded")
-}
-
-/// A short name of a mesh source (its file stem).
-pub fn mesh_name(source: &str) -> String {
-    let s = source.rsplit(':').next().unwrap_or(source);
-    Path::new(s).file_stem().and_then(|n| n.to_str()).unwrap_or(s).to_string()
 }
 
 #[cfg(test)]
@@ -555,12 +428,12 @@ mod tests {
         ball_only.data.captures.clear();
         let (found, notes) = ball_only.with_captures_found(root).unwrap();
         assert!(found.data.captures.is_empty() && found.data.optional_captures.is_empty());
-        assert_eq!(notes.len(), 5);
+        assert_eq!(notes.len(), 1, "one note for DiLiGenT-MV's five objects: {notes:?}");
         assert!(
-            notes[0].contains("diligent-mv") && notes[0].contains("fetch-data"),
-            "{}",
-            notes[0]
+            notes[0].starts_with("skipped 5 optional captures (diligent-mv:bear, "),
+            "{notes:?}"
         );
+        assert!(notes[0].contains("fetch-data diligent-mv"), "{}", notes[0]);
     }
 
     #[test]
@@ -571,15 +444,6 @@ mod tests {
         let text = "name = \"x\"\n[data]\nmeshes = [\"embedded:spot\"]\n";
         let e = SweepProfile::parse(text, "x.toml").unwrap_err().to_string();
         assert!(e.contains("data.materials"), "{e}");
-    }
-
-    #[test]
-    fn mesh_sources() {
-        assert_eq!(mesh_name("embedded:spot"), "spot");
-        assert_eq!(mesh_name("data:meshes/stanford-bunny.obj"), "stanford-bunny");
-        assert!(resolve_mesh("embedded:spot", Path::new(".")).is_ok());
-        let e = resolve_mesh("data:meshes/nope.obj", Path::new("/nonexistent")).unwrap_err();
-        assert!(e.to_string().contains("fetch-data"), "{e}");
     }
 
     #[test]

@@ -169,11 +169,11 @@ pub fn findings(paper: &[RunRecord], ours: &[RunRecord]) -> Vec<Finding> {
             claim,
             holds: Some(nmin.1 >= 100.0 * smax.1),
             evidence: format!(
-                "lowest purely neural reciprocity RMSE {:.2e} ({}) against the highest \
-                 symmetric {:.2e} ({}); rule: at least 100 times",
-                nmin.1,
+                "lowest purely neural reciprocity RMSE {} ({}) against the highest symmetric {} \
+                 ({}); rule: at least 100 times",
+                scientific(nmin.1),
                 nmin.0.paper_name(),
-                smax.1,
+                scientific(smax.1),
                 smax.0.paper_name()
             ),
         }
@@ -243,6 +243,11 @@ pub fn findings(paper: &[RunRecord], ours: &[RunRecord]) -> Vec<Finding> {
     out
 }
 
+/// `v` as 6.04e-4, and 0 as 0.
+fn scientific(v: f64) -> String {
+    if v == 0.0 { "0".into() } else { format!("{v:.2e}") }
+}
+
 fn min(v: &[(ModelKind, f64)]) -> (ModelKind, f64) {
     *v.iter().min_by(|a, b| a.1.total_cmp(&b.1)).expect("non-empty")
 }
@@ -309,10 +314,13 @@ mod tests {
     #[test]
     fn each_finding_can_fail() {
         let (paper, ours) = story();
+        // The record of (model, data set) replaced by one holding only `k` = `v`, on the same
+        // object.
         let with = |recs: &[RunRecord], m: ModelKind, d: Dataset, k: MetricKind, v: f64| {
             let mut r = recs.to_vec();
-            r.retain(|x| !(x.model == m && x.dataset == d));
-            r.push(RunRecord::new(m, d, "obj").with_value(k, v));
+            let i = r.iter().position(|x| x.model == m && x.dataset == d).unwrap();
+            let object = r.remove(i).object;
+            r.push(RunRecord::new(m, d, object).with_value(k, v));
             r
         };
         // A parametric model above a neural one.

@@ -121,13 +121,14 @@ impl PaperComparison {
                         format!("ours {lo:.2} to {hi:.2}, mean {m:.2}")
                     }
                 };
+                let unit = if r.metric == crate::record::MetricKind::Psnr { " dB" } else { "" };
+                let tol = format!("±{}{unit}", c.tolerance);
                 let verdict = match c.verdict {
-                    Verdict::Within => format!("within ±{} of the paper's mean", c.tolerance),
-                    Verdict::Undecided => format!(
-                        "within ±{} of the paper's range; its mean is needed to decide",
-                        c.tolerance
-                    ),
-                    Verdict::Outside => format!("more than ±{} from the paper", c.tolerance),
+                    Verdict::Within => format!("within {tol} of the paper's mean"),
+                    Verdict::Undecided => {
+                        format!("within {tol} of the paper's range; its mean is needed to decide")
+                    }
+                    Verdict::Outside => format!("more than {tol} from the paper"),
                     Verdict::NotRun => "not checked".into(),
                 };
                 format!(
@@ -184,10 +185,16 @@ impl PaperComparison {
         }
         s += "\n## The paper's findings on our runs\n\n";
         for f in &self.findings {
-            s += &format!("* **{}**: {}. {}.\n", f.verdict(), f.claim, f.evidence);
+            s += &format!("* **{}**: {}. {}.\n", f.verdict(), f.claim, sentence(&f.evidence));
         }
         s
     }
+}
+
+/// `s` with its first letter in upper case.
+pub fn sentence(s: &str) -> String {
+    let mut c = s.chars();
+    c.next().map_or_else(String::new, |f| f.to_uppercase().chain(c).collect())
 }
 
 #[cfg(test)]
