@@ -1,5 +1,5 @@
 //! The paper beside ours: its published Table 1 as data ([`data`]), our runs under its
-//! protocol cell by cell with the differences ([`compare`]), the ranking agreement per metric
+//! protocol cell by cell with the differences ([`mod@compare`]), the ranking agreement per metric
 //! (Kendall's τ-b, [`agreement`]), and a checklist of its findings on our runs ([`findings`]).
 //! [`PaperComparison`] gathers them; `collect` writes it as `tables/paper-vs-ours.md` and as
 //! a section of the HTML report.
