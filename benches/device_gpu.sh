@@ -12,6 +12,8 @@
 #   bash benches/device_gpu.sh e2e       # logs packed into $OUT/e2e.tar.gz (a third lease)
 #   bash benches/device_gpu.sh paper     # the full profile's one scene, all 9 models; one lease
 #   bash benches/device_gpu.sh eval      # evaluation's start-up, previous build against this one
+#   bash benches/device_gpu.sh loop      # the loop with losses read every step or every 100 steps,
+#                                        # SM use, and the warm-up with a persistent GPU cache
 #
 # With autotune on (the wgpu feature), the first use of every matrix-product shape in a process
 # is benchmarked, and the first process on a fresh machine also compiles every kernel and runs
@@ -211,6 +213,29 @@ if [ "$STAGE" = e2e ]; then
     run 100 full_scene.log $B/profile_steps --prepare benches/profiles/paper_one_scene.toml /tmp/full
     run 200 profile_full_wgpu.log $B/profile_steps /tmp/full spot__blue-acrylic \
         "${FULL_STEPS:-50}" wgpu "${FULL_MODELS:-SingleMlp,AdditiveSharedEnhanced,Disney}"
+fi
+if [ "$STAGE" = loop ]; then
+    # The training loop's host round trips (item 2 of the throughput issue): the default run's
+    # Single MLP and FMBRDF for the 1,400 steps of the converged CPU fit, reading the loss
+    # every step (NEURAL_BRDF_LOSS_READS=1, the loop before the loss windows) and every 100
+    # steps (the GPU's default, `experiments::trainer::GPU_LOSS_READS`), alternately, with
+    # `nvidia-smi dmon` sampling the SM use every second (the log marks where each run starts).
+    # The four runs are separate processes sharing one fresh persistent GPU cache
+    # (brdf_neural::gpu_cache): the first pays autotune and kernel compilation in its warm-up
+    # table, the later ones show what is left of that start-up.
+    export PROFILE_WARMUP_STEPS=50 PROFILE_EVAL=none NEURAL_BRDF_GPU_CACHE=/tmp/gpu-cache
+    rm -rf "$NEURAL_BRDF_GPU_CACHE"
+    run 60 default_scenes.log $B/profile_steps --prepare default /tmp/default
+    nvidia-smi dmon -s u -d 1 -o T >"$LOGS/gpu_use.log" 2>&1 &
+    DMON=$!
+    for round in 1 2; do
+        for reads in 1 100; do
+            echo "== $(date +%T) reads $reads round $round" >>"$LOGS/gpu_use.log"
+            run 70 "loop_reads${reads}_r$round.log" env NEURAL_BRDF_LOSS_READS=$reads \
+                $B/profile_steps /tmp/default spot__blue-acrylic 1400 wgpu SingleMlp,Fmbrdf
+        done
+    done
+    kill $DMON
 fi
 step "done"
 tar -czf "$OUT/$STAGE.tar.gz" -C "$LOGS" .

@@ -59,6 +59,16 @@ impl SpatialTable {
     pub fn points(&self) -> usize {
         self.points
     }
+
+    /// Width of a row (the model's `spatial_dim`).
+    pub fn width(&self) -> usize {
+        self.rows.dims()[1]
+    }
+
+    /// The rows `points`, `[points.len(), width]`.
+    pub(crate) fn select(&self, points: Tensor<1, Int>) -> Tensor<2> {
+        self.rows.clone().select(0, points)
+    }
 }
 
 /// NaN to 0 and every value into [-[`SPATIAL_LIMIT`], [`SPATIAL_LIMIT`]], on every thread.

@@ -41,6 +41,7 @@ mod error;
 pub mod eval;
 pub mod export;
 pub mod loss;
+mod loss_window;
 pub mod plateau;
 pub mod profile;
 pub mod run_dir;

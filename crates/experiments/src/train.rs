@@ -19,7 +19,9 @@ use crate::config::RunConfig;
 use crate::data::{TrainingData, spatial_features, split_validation, validation_pairs};
 use crate::run_dir::{RunDir, RunMetrics};
 use crate::train_config::OutputInit;
-use crate::trainer::{Loop, LoopEnd, device_table, gamma_mse, save_weights};
+use crate::trainer::{
+    GPU_LOSS_READS, Loop, LoopEnd, device_records, device_table, gamma_mse, save_weights,
+};
 use crate::{Error, Result};
 use brdf_neural::precision::MatmulPrecision;
 use brdf_neural::{BrdfModel, batch_split};
@@ -49,10 +51,16 @@ pub struct FitOptions {
     pub config_from_run_dir: bool,
     /// The burn backend that trains (`--backend`; default: the CPU backend).
     pub backend: brdf_neural::device::Backend,
-    /// Whether each batch selects its spatial rows from a table kept on the device
-    /// ([`crate::trainer::device_table`]); `None`: on GPU backends. The same values either
-    /// way (tests compare the two on the CPU).
-    pub spatial_on_device: Option<bool>,
+    /// Whether each batch selects its inputs from tables kept on the device: its spatial rows
+    /// ([`crate::trainer::device_table`]) and its records' directions, weights and targets
+    /// ([`crate::trainer::device_records`]), so that a step uploads only its record indices;
+    /// `None`: on GPU backends. The same values either way (tests compare the two on the CPU).
+    pub inputs_on_device: Option<bool>,
+    /// Steps between host reads of the training loss; between reads each step's loss stays
+    /// on the device and the host queues the next step at once. `None`: 1 on the CPU,
+    /// [`crate::trainer::GPU_LOSS_READS`] on GPU backends. The losses and weights do not
+    /// depend on it (a non-finite loss is still named at its step).
+    pub loss_reads: Option<u64>,
 }
 
 /// How [`fit`] ended.
@@ -223,9 +231,22 @@ pub fn fit_and_keep(
     }
     let resumed_from = state.step;
     let bar = progress_bar(options.progress, t.iterations, state.step);
-    let on_device = options.spatial_on_device.unwrap_or(options.backend.is_gpu());
+    let on_device = options.inputs_on_device.unwrap_or(options.backend.is_gpu());
     let spatial = device_table(&config.model, &data, on_device, &device)?;
-    let lp = Loop { config, run: &dir, data: &data, val: &val, device, spatial, bar };
+    let gpu_reads = if options.backend.is_gpu() { GPU_LOSS_READS } else { 1 };
+    let loss_reads = options.loss_reads.or(loss_reads_from_env()?).unwrap_or(gpu_reads).max(1);
+    let records = device_records(&config.model, &data, spatial.as_ref(), on_device, &device)?;
+    let lp = Loop {
+        config,
+        run: &dir,
+        data: &data,
+        val: &val,
+        device,
+        spatial,
+        records,
+        bar,
+        loss_reads,
+    };
     // The matrix-product precision of this thread's training steps; evaluation keeps f32.
     let precision = t.matmul_precision.scope(options.backend)?;
     if t.matmul_precision == MatmulPrecision::Bf16 && !MatmulPrecision::bf16_native() {
@@ -274,6 +295,23 @@ pub fn fit_and_keep(
     let device = lp.device.inner();
     let trained = Trained { model: model.valid(), device, scene };
     Ok((FitOutcome::Finished { metrics, resumed_from }, Some(trained)))
+}
+
+/// `NEURAL_BRDF_LOSS_READS`: steps between host reads of the training loss, for runs whose
+/// [`FitOptions::loss_reads`] is unset (`1` reads every step, as the CPU does; the GPU
+/// measurements compare the two).
+fn loss_reads_from_env() -> Result<Option<u64>> {
+    const VAR: &str = "NEURAL_BRDF_LOSS_READS";
+    match std::env::var(VAR) {
+        Err(_) => Ok(None),
+        Ok(v) => match v.trim().parse::<u64>() {
+            Ok(n) if n > 0 => Ok(Some(n)),
+            _ => Err(Error::format(
+                Path::new(VAR),
+                format!("`{v}` is not a positive number of steps between reads of the loss"),
+            )),
+        },
+    }
 }
 
 /// The training progress bar over the step budget, at `position` (hidden unless `visible`).

@@ -11,11 +11,12 @@ use crate::config::RunConfig;
 use crate::data::TrainingData;
 use crate::diagnose::{all_finite, diagnose, worst_input};
 use crate::loss::{LossWeights, loss, srgb_oetf};
+use crate::loss_window::{FreshLeaves, LossWindow, StepLoss, WindowStart};
 use crate::plateau::{Decision, StopReason};
 use crate::profile::{Phase, PhaseTimer};
 use crate::run_dir::{CurveRow, RunDir, Snapshot, write_curve};
 use crate::{Error, Result};
-use brdf_neural::{BrdfModel, Reciprocity, Samples, SpatialTable};
+use brdf_neural::{BrdfBatch, BrdfModel, Reciprocity, RecordTable, Samples, SpatialTable};
 use burn::module::Module;
 use burn::optim::{GradientsParams, ModuleOptimizer};
 use burn::tensor::{Device, Tensor, TensorData};
@@ -54,6 +55,23 @@ pub(crate) struct Loop<'a> {
     pub spatial: Option<SpatialTable>,
     /// The progress bar (hidden when not shown).
     pub bar: ProgressBar,
+    /// On a GPU: every record's direction inputs, weights and targets on the device, where each
+    /// batch selects its rows ([`device_records`]); `None`: batches gather them on the CPU.
+    pub records: Option<DeviceRecords>,
+    /// Steps between host reads of the training loss ([`crate::loss_window`]): 1 on the CPU,
+    /// [`GPU_LOSS_READS`] on a GPU.
+    pub loss_reads: u64,
+}
+
+/// Steps between host reads of the loss on a GPU (`FitOptions::loss_reads`' default there).
+pub const GPU_LOSS_READS: u64 = 100;
+
+/// A window to replay: its start, the index of its first non-finite step, and the plateau's
+/// rate scale (constant within a window: it changes only at validations, which read).
+struct Replay {
+    from: WindowStart,
+    bad: u64,
+    plateau_lr_scale: f64,
 }
 
 /// The batch generator of `step`: a function of (seed, step) only.
@@ -82,16 +100,61 @@ impl Loop<'_> {
         let (start, seconds_before) = (Instant::now(), state.seconds);
         let mut window = (Instant::now(), state.step);
         let mut timer = PhaseTimer::start(std::mem::take(&mut state.phases));
+        let mut losses = LossWindow::default();
         while state.step < t.iterations && state.stopped.is_none() {
             let step = state.step;
+            if losses.is_empty() {
+                // Handles to the same tensors: the replay's start, should a loss in the
+                // window not be finite.
+                let keep = (self.loss_reads > 1).then(|| (model.clone(), optim.clone()));
+                losses.open(step, keep);
+            }
             if let Some(h) = hook.as_mut() {
-                model = h(step, model);
+                // A hook that computes parameters from parameters (a test's NaN) leaves them
+                // inside its operation's graph, which the step's backward pass consumes: the
+                // next step (inside a loss window) needs them as leaves again.
+                model = h(step, model).map(&mut FreshLeaves);
             }
             let lr = t.lr_at(step) * state.plateau.lr_scale;
             timer.charge(Phase::Bookkeeping);
-            let value;
-            (model, value) = self.step(model, optim, (step, lr), &last_checkpoint, &mut timer)?;
+            let loss;
+            let read_now = self.loss_reads == 1;
+            (model, loss) =
+                self.step(model, optim, (step, lr), &last_checkpoint, &mut timer, read_now)?;
             state.step += 1;
+            losses.push(state.step, lr, seconds_before + start.elapsed().as_secs_f64(), loss);
+            self.bar.set_position(state.step);
+            if !self.must_read(state.step, stop_after) {
+                timer.end_step();
+                continue;
+            }
+            let read = match losses.read() {
+                Ok(read) => read,
+                Err(bad_window) => {
+                    let (from, bad) = *bad_window;
+                    let replay = Replay { from, bad, plateau_lr_scale: state.plateau.lr_scale };
+                    return Err(self.replay(
+                        replay,
+                        optim,
+                        &last_checkpoint,
+                        &mut hook,
+                        &mut timer,
+                    ));
+                }
+            };
+            timer.charge(Phase::Loss);
+            let Some((last, earlier)) = read.split_last() else { continue };
+            for s in earlier.iter().filter(|s| s.step.is_multiple_of(t.log_every)) {
+                let row = CurveRow {
+                    step: s.step,
+                    loss: s.loss,
+                    val_loss: None,
+                    lr: s.lr,
+                    seconds: s.seconds,
+                };
+                state.curve.push(row);
+            }
+            let (value, lr) = (last.loss, last.lr);
             let val_loss = self.maybe_validate(&model, &mut state)?;
             timer.charge(Phase::Validation);
             timer.end_step();
@@ -101,7 +164,6 @@ impl Loop<'_> {
                 state.curve.push(CurveRow { step: state.step, loss: value, val_loss, lr, seconds });
                 self.report(&state, value, &mut window);
             }
-            self.bar.set_position(state.step);
             if t.snapshots && t.snapshot_steps().contains(&state.step) {
                 self.save_snapshot(&model, state.step)?;
                 state.snapshots.push(Snapshot { step: state.step, seconds });
@@ -127,8 +189,60 @@ impl Loop<'_> {
         Ok(LoopEnd::Done(Box::new((model, state))))
     }
 
+    /// Whether the losses must be read after `step` steps: every `loss_reads` steps, and
+    /// wherever the loop needs them or the weights (validation, checkpoint, snapshot, the end).
+    fn must_read(&self, step: u64, stop_after: Option<u64>) -> bool {
+        let t = &self.config.train;
+        step.is_multiple_of(self.loss_reads)
+            || (!self.val.is_empty() && step.is_multiple_of(t.validate_every))
+            || step.is_multiple_of(t.checkpoint_every)
+            || (t.snapshots && t.snapshot_steps().contains(&step))
+            || step >= t.iterations
+            || stop_after.is_some_and(|s| step >= s)
+    }
+
+    /// Puts back the model and optimiser of the window's start and repeats its steps reading
+    /// every loss, up to the first non-finite one: the error an immediate read gives (the
+    /// step, the weights' diagnosis, the batch's worst input).
+    fn replay(
+        &self,
+        replay: Replay,
+        optim: &mut ModuleOptimizer,
+        last_checkpoint: &Option<PathBuf>,
+        hook: &mut Option<StepHook>,
+        timer: &mut PhaseTimer,
+    ) -> Error {
+        let Replay { from, bad, plateau_lr_scale } = replay;
+        let not_reproduced = |detail: &str| {
+            self.bar.abandon();
+            Error::NonFinite {
+                step: bad,
+                loss: f32::NAN,
+                diagnosis: format!("the loss of step {bad} was not finite; {detail}"),
+                checkpoint: last_checkpoint.clone(),
+            }
+        };
+        let first = from.step;
+        let Some((mut model, saved)) = from.into_state() else {
+            return not_reproduced("no state was kept to replay it");
+        };
+        *optim = saved;
+        for step in first..=bad {
+            if let Some(h) = hook.as_mut() {
+                model = h(step, model).map(&mut FreshLeaves);
+            }
+            let lr = self.config.train.lr_at(step) * plateau_lr_scale;
+            match self.step(model, optim, (step, lr), last_checkpoint, timer, true) {
+                Ok((next, _)) => model = next,
+                Err(e) => return e,
+            }
+        }
+        not_reproduced(&format!("replaying steps {first}..={bad} did not repeat it"))
+    }
+
     /// One optimiser step number `step` at rate `lr`: the batch of `step`, the loss, its
-    /// gradient, Adam; `timer` is charged with each phase.
+    /// gradient, Adam; `timer` is charged with each phase. With `read_now` the loss is read
+    /// (and a non-finite one is an error at once); otherwise it stays on the device.
     fn step(
         &self,
         model: BrdfModel,
@@ -136,29 +250,14 @@ impl Loop<'_> {
         (step, lr): (u64, f64),
         last_checkpoint: &Option<PathBuf>,
         timer: &mut PhaseTimer,
-    ) -> Result<(BrdfModel, f32)> {
+        read_now: bool,
+    ) -> Result<(BrdfModel, StepLoss)> {
         let (t, c) = (&self.config.train, &self.config.model);
         let bs = t.batch_size;
         let mut rng = step_rng(self.config.seed, step);
         let n = self.data.len();
         let indices: Vec<usize> = (0..bs).map(|_| rng.random_range(0..n)).collect();
-        let cpu = match &self.spatial {
-            Some(_) => self.data.gather_fields(&indices),
-            None => self.data.gather(&indices),
-        };
-        timer.charge(Phase::Gather);
-        let swap = c.angles.reciprocity == Reciprocity::RandomSwap;
-        let mask = swap.then(|| c.angles.swap_mask(bs, &mut rng));
-        let (l, v, mask) = (&cpu.l, &cpu.v, mask.as_deref());
-        let batch = match &self.spatial {
-            Some(table) => {
-                let points = self.data.points_of(&indices);
-                c.batch_from_table(table, &points, l, v, mask, &self.device)?
-            }
-            None => c.batch_owned(cpu.spatial, l, v, mask, &self.device)?,
-        };
-        let weight = tensor(cpu.weight, bs, &self.device);
-        let target = tensor(cpu.target_gamma, bs, &self.device);
+        let (batch, weight, target) = self.batch(&indices, &mut rng, timer)?;
         timer.charge(Phase::Encode);
         let out = model.forward(&batch);
         timer.charge(Phase::Forward);
@@ -168,9 +267,14 @@ impl Loop<'_> {
             clip: self.data.clip,
         };
         let total = loss(&out, weight, target, c.kind.is_enhanced(), weights);
-        let value: f32 = total.clone().into_scalar::<f32>();
+        let value = match read_now {
+            true => StepLoss::Read(total.clone().into_scalar::<f32>()),
+            false => StepLoss::OnDevice(Box::new(total.clone().detach())),
+        };
         timer.charge(Phase::Loss);
-        if !value.is_finite() {
+        if let StepLoss::Read(bad) = &value
+            && !bad.is_finite()
+        {
             self.bar.abandon();
             // The batch again, unsanitised (the batch took its spatial rows): what was fed.
             let cpu = self.data.gather(&indices);
@@ -178,7 +282,7 @@ impl Loop<'_> {
             let input = worst_input(&out, &samples);
             return Err(Error::NonFinite {
                 step,
-                loss: value,
+                loss: *bad,
                 diagnosis: format!("{}; {input}", diagnose(&model)),
                 checkpoint: last_checkpoint.clone(),
             });
@@ -188,6 +292,49 @@ impl Loop<'_> {
         let model = optim.step(lr, model, grads);
         timer.charge(Phase::Optimizer);
         Ok((model, value))
+    }
+
+    /// The batch of the records `indices` (model input, weights, targets), with the swap mask
+    /// drawn from `rng` after the indices: selected on the device from [`DeviceRecords`] when
+    /// the loop has them, else gathered, encoded and uploaded here. The same values either way.
+    fn batch(
+        &self,
+        indices: &[usize],
+        rng: &mut StdRng,
+        timer: &mut PhaseTimer,
+    ) -> Result<(BrdfBatch, Tensor<2>, Tensor<2>)> {
+        let (c, bs) = (&self.config.model, indices.len());
+        let swap = c.angles.reciprocity == Reciprocity::RandomSwap;
+        if let Some(records) = &self.records {
+            let rows: Vec<u32> = indices.iter().map(|&i| i as u32).collect();
+            timer.charge(Phase::Gather);
+            let mask = swap.then(|| c.angles.swap_mask(bs, rng));
+            let index = records.table.index(&rows, mask.as_deref(), &self.device)?;
+            let batch =
+                c.batch_from_records(&records.table, self.spatial.as_ref(), &index, &self.device)?;
+            let weight = records.weight.clone().select(0, index.rows.clone());
+            let target = records.target.clone().select(0, index.rows);
+            timer.charge(Phase::Encode);
+            return Ok((batch, weight, target));
+        }
+        let cpu = match &self.spatial {
+            Some(_) => self.data.gather_fields(indices),
+            None => self.data.gather(indices),
+        };
+        timer.charge(Phase::Gather);
+        let mask = swap.then(|| c.angles.swap_mask(bs, rng));
+        let (l, v, mask) = (&cpu.l, &cpu.v, mask.as_deref());
+        let batch = match &self.spatial {
+            Some(table) => {
+                let points = self.data.points_of(indices);
+                c.batch_from_table(table, &points, l, v, mask, &self.device)?
+            }
+            None => c.batch_owned(cpu.spatial, l, v, mask, &self.device)?,
+        };
+        let weight = tensor(cpu.weight, bs, &self.device);
+        let target = tensor(cpu.target_gamma, bs, &self.device);
+        timer.charge(Phase::Encode);
+        Ok((batch, weight, target))
     }
 
     /// After every `validate_every` steps: the validation loss, fed to the plateau rule (which
@@ -255,6 +402,45 @@ impl Loop<'_> {
 /// Largest spatial table [`device_table`] puts on a GPU, in bytes (a 512 px scene of the
 /// `full` profile needs at most 0.42 GB: 652,749 training pixels x 160 floats for Spot).
 pub const DEVICE_TABLE_MAX_BYTES: usize = 2 << 30;
+
+/// The training records on the device: their direction inputs ([`RecordTable`]), weights
+/// (`E cos theta_l`) and targets (the observations' sRGB values), `[records, 3]` each.
+pub struct DeviceRecords {
+    /// The direction inputs and points.
+    pub table: RecordTable,
+    /// Each record's weight.
+    pub weight: Tensor<2>,
+    /// Each record's target.
+    pub target: Tensor<2>,
+}
+
+/// Largest record table [`device_records`] puts on a GPU, in bytes, weights and targets
+/// included.
+pub const DEVICE_RECORDS_MAX_BYTES: usize = 4 << 30;
+
+/// Every record of `data` on `device` when `on_device` (the trainer's default on a GPU) and
+/// the model's spatial rows are there too (`spatial`, from [`device_table`]): each batch then
+/// uploads only its record indices. `None` otherwise, or past [`DEVICE_RECORDS_MAX_BYTES`].
+pub fn device_records(
+    model: &brdf_neural::ModelConfig,
+    data: &TrainingData,
+    spatial: Option<&SpatialTable>,
+    on_device: bool,
+    device: &Device,
+) -> Result<Option<DeviceRecords>> {
+    let n = data.len();
+    let bytes = model.record_table_bytes(n) + n * 6 * 4;
+    if !on_device
+        || (model.spatial_dim > 0 && spatial.is_none())
+        || bytes > DEVICE_RECORDS_MAX_BYTES
+    {
+        return Ok(None);
+    }
+    let table = model.record_table(&data.l, &data.v, &data.point, device)?;
+    let weight = tensor(data.weight.as_flattened().to_vec(), n, device);
+    let target = tensor(data.observed_gamma.as_flattened().to_vec(), n, device);
+    Ok(Some(DeviceRecords { table, weight, target }))
+}
 
 /// The spatial rows of every point of `data` on `device` when `on_device` (the trainer's
 /// default on a GPU): each batch then selects its rows there, instead of 640 bytes a sample

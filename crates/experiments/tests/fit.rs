@@ -241,20 +241,62 @@ fn runs_are_deterministic_and_resume_is_exact() {
     assert!(msg.contains("train.iterations"), "{msg}");
 }
 
-/// Batches whose spatial rows are selected from a table on the device (a GPU's default) train
-/// exactly as batches gathered on the CPU: the same losses to the bit, on the CPU backend.
+/// Batches selected on the device from tables of every point and record (a GPU's default:
+/// spatial rows, encoded angles or geometry terms, weights, targets) train exactly as batches
+/// gathered and encoded on the CPU: the same losses and weights to the bit, on the CPU backend,
+/// for angle features with and without random swaps, the parametric geometry, and FMBRDF's.
 #[test]
-fn spatial_rows_selected_on_the_device_train_like_gathered_ones() {
+fn inputs_selected_on_the_device_train_like_gathered_ones() {
     let dir = TempDir::new("table");
-    for kind in ["single_mlp", "disney"] {
-        let c = config(kind, 30, "validate_every = 10\n");
-        let (a, b) = (dir.0.join(format!("{kind}-host")), dir.0.join(format!("{kind}-table")));
-        fit(&c, &a, FitOptions { spatial_on_device: Some(false), ..Default::default() }).unwrap();
-        fit(&c, &b, FitOptions { spatial_on_device: Some(true), ..Default::default() }).unwrap();
-        assert_eq!(losses(&a).len(), 3, "{kind}");
-        assert_eq!(losses(&a), losses(&b), "{kind}: losses differ");
+    for (kind, swap) in
+        [("single_mlp", false), ("single_mlp", true), ("disney", false), ("fmbrdf", false)]
+    {
+        let mut c = config(kind, 30, "validate_every = 10\n");
+        if swap {
+            c.model.angles.reciprocity = brdf_neural::Reciprocity::RandomSwap;
+            c.model.angles.swap_probability = 0.5;
+        }
+        let name = format!("{kind}-{swap}");
+        let (a, b) = (dir.0.join(format!("{name}-host")), dir.0.join(format!("{name}-table")));
+        fit(&c, &a, FitOptions { inputs_on_device: Some(false), ..Default::default() }).unwrap();
+        fit(&c, &b, FitOptions { inputs_on_device: Some(true), ..Default::default() }).unwrap();
+        assert_eq!(losses(&a).len(), 3, "{name}");
+        assert_eq!(losses(&a), losses(&b), "{name}: losses differ");
         let weights = |run: &Path| std::fs::read(run.join("weights.bpk")).unwrap();
-        assert!(weights(&a) == weights(&b), "{kind}: the fitted weights differ");
+        assert!(weights(&a) == weights(&b), "{name}: the fitted weights differ");
+    }
+}
+
+/// Losses left on the device and read in windows (a GPU's default) train exactly as losses
+/// read every step: the same curve, validation losses and weights to the bit, for windows that
+/// divide nothing (7 steps), span several curve rows and validations (45), and with the run
+/// interrupted and resumed in the middle of a window.
+#[test]
+fn losses_read_in_windows_train_like_losses_read_every_step() {
+    let dir = TempDir::new("windows");
+    let curve = |run: &Path| -> Vec<String> {
+        let text = std::fs::read_to_string(RunDir::new(run).curve()).unwrap();
+        text.lines().map(|l| l.rsplit_once(',').unwrap().0.to_string()).collect()
+    };
+    let weights = |run: &Path| std::fs::read(run.join("weights.bpk")).unwrap();
+    for kind in ["single_mlp", "disney"] {
+        let c = config(kind, 50, "validate_every = 15\npatience = 20\n");
+        let every = dir.0.join(format!("{kind}-1"));
+        let options = |reads: u64| FitOptions { loss_reads: Some(reads), ..Default::default() };
+        fit(&c, &every, options(1)).unwrap();
+        assert_eq!(curve(&every).len(), 1 + 5 + 2, "{kind}: 5 log rows and 2 validation rows");
+        for reads in [7, 45] {
+            let run = dir.0.join(format!("{kind}-{reads}"));
+            fit(&c, &run, options(reads)).unwrap();
+            assert_eq!(curve(&every), curve(&run), "{kind}, reads every {reads}: curves differ");
+            assert!(weights(&every) == weights(&run), "{kind}, reads every {reads}: weights");
+        }
+        let resumed = dir.0.join(format!("{kind}-resumed"));
+        let stop = FitOptions { stop_after: Some(26), loss_reads: Some(7), ..Default::default() };
+        assert_eq!(fit(&c, &resumed, stop).unwrap(), FitOutcome::Stopped(26));
+        fit(&c, &resumed, options(7)).unwrap();
+        assert_eq!(curve(&every), curve(&resumed), "{kind}: the resumed run's curve differs");
+        assert!(weights(&every) == weights(&resumed), "{kind}: the resumed run's weights");
     }
 }
 
@@ -299,26 +341,34 @@ impl ModuleMapper for Poison {
     }
 }
 
+/// The same error whether the loss is read every step or in windows of 16 steps left on the
+/// device (the NaN at step 25 is found at the read after step 32, and steps 20 to 25 replayed).
 #[test]
 fn a_non_finite_loss_stops_the_run_and_keeps_the_last_checkpoint() {
     let dir = TempDir::new("nan");
-    let run = dir.0.join("run");
-    let hook = Box::new(|step: u64, model: brdf_neural::BrdfModel| {
-        if step == 25 { burn::module::Module::map(model, &mut Poison(false)) } else { model }
-    });
-    let options = FitOptions { hook: Some(hook), ..Default::default() };
-    let err = fit(&config("disney", 100, ""), &run, options).unwrap_err();
-    let msg = err.to_string();
-    assert!(matches!(err, Error::NonFinite { step: 25, .. }), "{msg}");
-    assert!(msg.contains("step 25"), "{msg}");
-    assert!(
-        msg.contains("non-finite parameters in Parametric.mlp.layers.0.weight (96 non-finite);"),
-        "{msg}"
-    );
-    assert!(msg.contains("step-000000020"), "{msg}");
-    assert!(msg.contains("the batch's worst input: output f = NaN at batch row 0: l = ["), "{msg}");
-    assert!(run.join("checkpoints/step-000000020/model.bpk").is_file());
-    assert!(!RunDir::new(&run).weights().exists());
+    for reads in [1, 16] {
+        let run = dir.0.join(format!("run-{reads}"));
+        let hook = Box::new(|step: u64, model: brdf_neural::BrdfModel| {
+            if step == 25 { burn::module::Module::map(model, &mut Poison(false)) } else { model }
+        });
+        let options =
+            FitOptions { hook: Some(hook), loss_reads: Some(reads), ..Default::default() };
+        let err = fit(&config("disney", 100, ""), &run, options).unwrap_err();
+        let msg = err.to_string();
+        assert!(matches!(err, Error::NonFinite { step: 25, .. }), "reads {reads}: {msg}");
+        assert!(msg.contains("step 25"), "{msg}");
+        assert!(
+            msg.contains(
+                "non-finite parameters in Parametric.mlp.layers.0.weight (96 non-finite);"
+            ),
+            "reads {reads}: {msg}"
+        );
+        assert!(msg.contains("step-000000020"), "{msg}");
+        let worst = "the batch's worst input: output f = NaN at batch row 0: l = [";
+        assert!(msg.contains(worst), "reads {reads}: {msg}");
+        assert!(run.join("checkpoints/step-000000020/model.bpk").is_file());
+        assert!(!RunDir::new(&run).weights().exists());
+    }
 }
 
 #[test]

@@ -8,7 +8,7 @@
 
 use angles::Vec3;
 use brdf_analytic::microfacet::{PairGeometry, schlick_weight};
-use burn::tensor::{Device, Tensor, TensorData};
+use burn::tensor::{Device, Int, Tensor, TensorData};
 use std::sync::Arc;
 
 /// FMBRDF's cosine clamp epsilon (official code: 1e-6).
@@ -159,6 +159,54 @@ impl Geometry {
             clearcoat_visibility: c(13),
             rv: c(14),
             rv_positive: c(15),
+            fmbrdf,
+        }
+    }
+
+    /// The geometry of the pairs `host[i]` (also uploaded as `index`), selected on the device:
+    /// the values [`Geometry::new`] gives for those pairs, without computing or uploading them
+    /// (a training loop's table of every record, [`crate::RecordTable`]).
+    pub fn select(&self, index: &Tensor<1, Int>, host: &[u32]) -> Self {
+        let pick = |t: &Tensor<2>| t.clone().select(0, index.clone());
+        let fmbrdf = self.fmbrdf.as_ref().map(|f| {
+            let n = f.nl.dims()[0];
+            let (tan_l, tan_v) =
+                (f.tan_lv.clone().narrow(0, 0, n), f.tan_lv.clone().narrow(0, n, n));
+            let tan_lv_host: Arc<[f32]> = host
+                .iter()
+                .map(|&i| f.tan_lv_host[i as usize])
+                .chain(host.iter().map(|&i| f.tan_lv_host[n + i as usize]))
+                .collect();
+            FmbrdfGeometry {
+                nl: pick(&f.nl),
+                nv: pick(&f.nv),
+                nh: pick(&f.nh),
+                theta_h: pick(&f.theta_h),
+                cos_h: pick(&f.cos_h),
+                cos_r: pick(&f.cos_r),
+                sin_r: pick(&f.sin_r),
+                tan_lv: Tensor::cat(vec![pick(&tan_l), pick(&tan_v)], 0),
+                tan_lv_host,
+                body: pick(&f.body),
+            }
+        });
+        Self {
+            mask: pick(&self.mask),
+            nl: pick(&self.nl),
+            nv: pick(&self.nv),
+            nl2: pick(&self.nl2),
+            nv2: pick(&self.nv2),
+            sin2_h: pick(&self.sin2_h),
+            cos2_h: pick(&self.cos2_h),
+            lh2: pick(&self.lh2),
+            schlick_l: pick(&self.schlick_l),
+            schlick_v: pick(&self.schlick_v),
+            schlick_h: pick(&self.schlick_h),
+            subsurface_cos: pick(&self.subsurface_cos),
+            clearcoat_fresnel: pick(&self.clearcoat_fresnel),
+            clearcoat_visibility: pick(&self.clearcoat_visibility),
+            rv: pick(&self.rv),
+            rv_positive: pick(&self.rv_positive),
             fmbrdf,
         }
     }

@@ -1,0 +1,106 @@
+//! Where the GPU backends keep what they measure and compile, once per machine.
+//!
+//! With burn's autotune, the first use of each problem shape in a process benchmarks the
+//! candidate kernels (a matrix product has dozens), and every kernel is compiled at its first
+//! launch: on a GPU that start-up took longer than the training it preceded. CubeCL can keep both
+//! in an on-disk store (its `persistence` feature: one database file, shared safely by several
+//! processes), which the GPU features turn on. By default CubeCL puts that store under the
+//! `target/` folder of the outermost Cargo project around the working directory, so a run
+//! started elsewhere, or an installed binary, would tune again. Here every process of a user on
+//! a machine, every run and every `--jobs` child, uses one folder:
+//!
+//! 1. `$NEURAL_BRDF_GPU_CACHE` when set;
+//! 2. else `$XDG_CACHE_HOME/neural-brdfs/gpu`;
+//! 3. else `$HOME/.cache/neural-brdfs/gpu`;
+//! 4. else the temporary folder's `neural-brdfs-gpu`.
+//!
+//! A `cubecl.toml` (or `burn.toml`) in the working directory or above it is CubeCL's own
+//! configuration and is left alone: its `[environment]` section says where the store is then.
+//! What is cached: autotune's choices (keyed by device, kernel and shape), and the compiled
+//! kernels where the runtime can keep them (CUDA's; wgpu keeps its SPIR-V pipelines only with
+//! the Vulkan compiler, so on wgpu the kernels are still compiled once per process).
+
+use std::path::PathBuf;
+
+/// The folder of the GPU backends' persistent caches (see the module documentation).
+pub fn gpu_cache_dir() -> PathBuf {
+    let var = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty()).map(PathBuf::from);
+    if let Some(dir) = var("NEURAL_BRDF_GPU_CACHE") {
+        return dir;
+    }
+    let base = var("XDG_CACHE_HOME").or_else(|| var("HOME").map(|h| h.join(".cache")));
+    match base {
+        Some(base) => base.join("neural-brdfs").join("gpu"),
+        None => std::env::temp_dir().join("neural-brdfs-gpu"),
+    }
+}
+
+/// Points CubeCL's persistent store at [`gpu_cache_dir`], before the first GPU device is
+/// made; does nothing when a CubeCL configuration file is found, or once CubeCL's
+/// configuration has been read.
+#[cfg(any(feature = "wgpu", feature = "cuda"))]
+pub(crate) fn configure() {
+    use cubecl::config::cache::CacheConfig;
+    use cubecl::config::{CubeClRuntimeConfig, RuntimeConfig};
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        if has_cubecl_file() {
+            return;
+        }
+        let mut config = CubeClRuntimeConfig::default().override_from_env();
+        config.environment.path = CacheConfig::Directory(gpu_cache_dir());
+        CubeClRuntimeConfig::try_set(config);
+    });
+}
+
+/// Whether a configuration file CubeCL reads exists in the working directory or above it.
+#[cfg(any(feature = "wgpu", feature = "cuda"))]
+fn has_cubecl_file() -> bool {
+    let Ok(mut dir) = std::env::current_dir() else { return false };
+    loop {
+        let found = ["cubecl.toml", "CubeCL.toml", "burn.toml", "Burn.toml"]
+            .iter()
+            .any(|name| dir.join(name).is_file());
+        if found {
+            return true;
+        }
+        if !dir.pop() {
+            return false;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The folder follows the documented order of variables. One test, because the
+    /// environment is the process's.
+    #[test]
+    fn the_cache_folder_follows_its_variables() {
+        let saved: Vec<_> = ["NEURAL_BRDF_GPU_CACHE", "XDG_CACHE_HOME", "HOME"]
+            .iter()
+            .map(|k| (*k, std::env::var_os(k)))
+            .collect();
+        // SAFETY: the only test of this crate's unit tests that reads or writes these
+        // variables; restored below.
+        unsafe {
+            std::env::set_var("NEURAL_BRDF_GPU_CACHE", "/x/gpu");
+            std::env::set_var("XDG_CACHE_HOME", "/xdg");
+            std::env::set_var("HOME", "/home/u");
+        }
+        assert_eq!(gpu_cache_dir(), PathBuf::from("/x/gpu"));
+        unsafe { std::env::set_var("NEURAL_BRDF_GPU_CACHE", "") };
+        assert_eq!(gpu_cache_dir(), PathBuf::from("/xdg/neural-brdfs/gpu"));
+        unsafe { std::env::remove_var("XDG_CACHE_HOME") };
+        assert_eq!(gpu_cache_dir(), PathBuf::from("/home/u/.cache/neural-brdfs/gpu"));
+        unsafe { std::env::remove_var("HOME") };
+        assert_eq!(gpu_cache_dir(), std::env::temp_dir().join("neural-brdfs-gpu"));
+        for (k, v) in saved {
+            match v {
+                Some(v) => unsafe { std::env::set_var(k, v) },
+                None => unsafe { std::env::remove_var(k) },
+            }
+        }
+    }
+}
