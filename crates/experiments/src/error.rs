@@ -71,6 +71,32 @@ pub enum Error {
         /// The last good checkpoint.
         checkpoint: Option<PathBuf>,
     },
+    /// The backend failed inside a training step or read (a GPU out of memory or lost: burn and
+    /// CubeCL panic there), caught by the training loop; the last checkpoint resumes the run.
+    #[error(
+        "{}: training stopped at step {step}: the {backend} backend failed: {message}; {}",
+        run.display(),
+        match checkpoint {
+            Some(c) => format!(
+                "the last checkpoint is {}: run the same command again to resume from it \
+                 (a smaller train.batch_size needs a new run directory)",
+                c.display()
+            ),
+            None => "no checkpoint was written yet: the run starts again from step 0".into(),
+        }
+    )]
+    BackendFault {
+        /// The run directory.
+        run: PathBuf,
+        /// Steps done when it failed.
+        step: u64,
+        /// The backend that trained.
+        backend: String,
+        /// What the backend said.
+        message: String,
+        /// The latest checkpoint.
+        checkpoint: Option<PathBuf>,
+    },
     /// The scene has no training sample.
     #[error("{}: no lit training sample", path.display())]
     NoSamples {

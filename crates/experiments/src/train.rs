@@ -12,7 +12,9 @@
 //! Checkpoints every `checkpoint_every` steps hold the weights, Adam's state, the curve and
 //! the plateau rule's state, so a resumed run computes the same steps as an uninterrupted one.
 //! A NaN or infinite loss stops the run at once with [`Error::NonFinite`] (step and parameter
-//! group), keeping the last good checkpoint.
+//! group), keeping the last good checkpoint. A failing backend (a GPU out of memory or lost,
+//! which burn and CubeCL report by panicking) ends it with [`Error::BackendFault`], naming the
+//! checkpoint that resumes it.
 
 use crate::checkpoint::{self, CheckpointState};
 use crate::config::RunConfig;
@@ -272,8 +274,23 @@ pub fn fit_and_keep(
     // GPU's matrix-product kernels do not split it themselves. The CPU keeps the plain product.
     let parts = if options.backend.is_gpu() { batch_split::gpu_parts(t.batch_size) } else { 1 };
     let split = batch_split::scope(parts);
-    let end =
-        lp.run(model, &mut optim, state, last_checkpoint, options.hook, options.stop_after)?;
+    // burn and CubeCL panic when a GPU runs out of memory or is lost: end with an error that
+    // says so and names the checkpoint that resumes, as for any other failure.
+    let (hook, stop_after) = (options.hook, options.stop_after);
+    let run_loop = || lp.run(model, &mut optim, state, last_checkpoint, hook, stop_after);
+    let end = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run_loop)) {
+        Ok(end) => end?,
+        Err(payload) => {
+            lp.bar.abandon();
+            return Err(Error::BackendFault {
+                run: run.to_path_buf(),
+                step: lp.bar.position(),
+                backend: options.backend.to_string(),
+                message: panic_message(payload.as_ref()),
+                checkpoint: checkpoint::latest(&dir)?,
+            });
+        }
+    };
     drop((precision, split));
     let (model, state) = match end {
         LoopEnd::Done(done) => *done,
@@ -295,6 +312,15 @@ pub fn fit_and_keep(
     let device = lp.device.inner();
     let trained = Trained { model: model.valid(), device, scene };
     Ok((FitOutcome::Finished { metrics, resumed_from }, Some(trained)))
+}
+
+/// The text of a caught panic.
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    match (payload.downcast_ref::<&str>(), payload.downcast_ref::<String>()) {
+        (Some(s), _) => s.to_string(),
+        (_, Some(s)) => s.clone(),
+        _ => "a panic without a message".into(),
+    }
 }
 
 /// `NEURAL_BRDF_LOSS_READS`: steps between host reads of the training loss, for runs whose

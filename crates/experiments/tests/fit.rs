@@ -371,6 +371,35 @@ fn a_non_finite_loss_stops_the_run_and_keeps_the_last_checkpoint() {
     }
 }
 
+/// A backend that fails inside a step (burn and CubeCL panic when a GPU runs out of memory or
+/// is lost; a hook panics here) ends the fit with an error naming the step, the backend's
+/// message and the checkpoint; the same command then resumes from that checkpoint and ends
+/// with the uninterrupted run's weights, byte for byte.
+#[test]
+fn a_failing_backend_ends_with_an_error_and_the_run_resumes() {
+    let dir = TempDir::new("fault");
+    let c = config("single_mlp", 40, "");
+    let (clean, faulty) = (dir.0.join("clean"), dir.0.join("faulty"));
+    fit(&c, &clean, FitOptions::default()).unwrap();
+    let hook = Box::new(|step: u64, model: brdf_neural::BrdfModel| {
+        if step == 25 {
+            panic!("out of memory (simulated): cannot allocate 2 GiB");
+        }
+        model
+    });
+    let options = FitOptions { hook: Some(hook), ..Default::default() };
+    let err = fit(&c, &faulty, options).unwrap_err();
+    let msg = err.to_string();
+    assert!(matches!(err, Error::BackendFault { step: 25, .. }), "{msg}");
+    assert!(msg.contains("the flex backend failed: out of memory (simulated)"), "{msg}");
+    assert!(msg.contains("step-000000020"), "{msg}");
+    assert!(msg.contains("run the same command again to resume"), "{msg}");
+    let out = fit(&c, &faulty, FitOptions::default()).unwrap();
+    assert!(matches!(out, FitOutcome::Finished { resumed_from: 20, .. }), "{out:?}");
+    let weights = |run: &Path| std::fs::read(run.join("weights.bpk")).unwrap();
+    assert!(weights(&clean) == weights(&faulty), "the resumed run's weights differ");
+}
+
 #[test]
 fn an_absurd_learning_rate_is_caught() {
     let dir = TempDir::new("lr");
