@@ -25,7 +25,7 @@
 #   3. the baseline: the previous build's training step (`.devrun_old/bin.tar.xz`, when
 #      carried: burn's wgpu without autotune, fusion or the batch split), same machine;
 #   4. the training step at batch 32,768, three model kinds on wgpu, without and with the batch
-#      split (`brdf_neural::batch_split`), one layer's products alone, and the Single MLP back to
+#      split (`brdf_neural::split_k`), one layer's products alone, and the Single MLP back to
 #      back with PyTorch on CUDA (f32, three rounds);
 #   5. where a step's GPU time goes: CubeCL's kernel profile of Single MLP steps, summed by kernel;
 #   6. the step on the machine's CPU cores (flex), without and with the batch split.

@@ -21,8 +21,8 @@
 //!   products ([`brdf_neural::precision`], flex only), with the PyTorch comparison under bf16
 //!   autocast, and the flex products themselves in both precisions;
 //! - `BRDF_BENCH_SPLIT=1,64` times every step with its linear layers' batch split into these
-//!   numbers of parts ([`brdf_neural::batch_split`]; default: what the trainer uses, 1 on the
-//!   CPU and [`brdf_neural::batch_split::gpu_parts`] on a GPU), and, on a GPU backend, prints
+//!   numbers of parts ([`brdf_neural::split_k`]; default: what the trainer uses, 1 on the
+//!   CPU and [`brdf_neural::split_k::gpu_parts`] on a GPU), and, on a GPU backend, prints
 //!   the times of one 128-wide layer's three products alone (forward, input gradient, weight
 //!   gradient plain and split).
 //!
@@ -48,10 +48,10 @@
 //! (stock burn-flex 0.22.1, glibc defaults) the same step took 298 to 311 ms against PyTorch's
 //! 225 to 235 ms (ratio 1.3).
 
-use brdf_neural::batch_split;
 use brdf_neural::device::Backend;
 use brdf_neural::mlp::MlpConfig;
 use brdf_neural::precision::MatmulPrecision;
+use brdf_neural::split_k;
 use brdf_neural::{BrdfBatch, BrdfModel, ModelConfig, ModelKind, Reciprocity, Samples};
 use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
 use burn::tensor::{Device, Distribution, Tensor};
@@ -111,7 +111,7 @@ struct Step {
     device: Device,
     backend: Backend,
     precision: MatmulPrecision,
-    /// Parts the linear layers' batch is split into ([`batch_split`]).
+    /// Parts the linear layers' batch is split into ([`split_k`]).
     split: usize,
 }
 
@@ -159,7 +159,7 @@ impl Step {
     /// Forward, radiance L = f * (E shadow cos), MSE, backward, Adam; waits for the device.
     fn run(&mut self) {
         let _precision = self.precision.scope(self.backend).expect("precision on this backend");
-        let _split = batch_split::scope(self.split);
+        let _split = split_k::scope(self.split);
         let model = self.model.take().expect("model");
         let out = model.forward(&self.batch);
         let loss = (out.f * self.weight.clone() - self.target.clone()).square().mean();
@@ -494,7 +494,7 @@ fn splits(backend: Backend, n: usize) -> Vec<usize> {
 
 /// The split the trainer uses on `backend` for a batch of `n`.
 fn default_split(backend: Backend, n: usize) -> usize {
-    if backend.is_gpu() { batch_split::gpu_parts(n) } else { 1 }
+    if backend.is_gpu() { split_k::gpu_parts(n) } else { 1 }
 }
 
 /// Prints the times of one 128-wide layer's products at batch `n` on `backend` (a GPU):

@@ -70,7 +70,6 @@
 pub mod additive_separate;
 pub mod additive_shared;
 pub mod batch;
-pub mod batch_split;
 pub mod device;
 mod error;
 pub mod features;
@@ -86,6 +85,7 @@ pub mod parametric;
 pub mod precision;
 pub mod record_table;
 pub mod single_mlp;
+pub mod split_k;
 pub mod tensor_brdf;
 
 pub use batch::{BrdfBatch, SPATIAL_LIMIT, Samples, SpatialTable};

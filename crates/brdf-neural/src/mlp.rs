@@ -19,10 +19,10 @@
 //! part of the raw input (and so of the skip), otherwise it is added to layer `late_into` only
 //! (the NOL ablation of the Single MLP feeds the directions in there).
 //!
-//! Every linear layer runs through [`crate::batch_split`], which splits the batch sum of the
+//! Every linear layer runs through [`crate::split_k`], which splits the batch sum of the
 //! weight gradients into parts on GPU backends.
 
-use crate::batch_split::linear;
+use crate::split_k::linear;
 use burn::module::Module;
 use burn::nn::{Linear, LinearConfig};
 use burn::tensor::activation::relu;

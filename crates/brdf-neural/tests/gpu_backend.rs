@@ -16,7 +16,7 @@
 //! gradients of a loss must match the CPU's to 1e-4 (relative). A Single MLP trained for 30
 //! Adam steps on both backends from the same start must follow the same loss curve to 1e-3, on
 //! the GPU also with its linear layers' batch split into parts as the trainer does there
-//! ([`brdf_neural::batch_split`]).
+//! ([`brdf_neural::split_k`]).
 #![cfg(any(feature = "wgpu", feature = "cuda"))]
 
 mod common;
@@ -116,7 +116,7 @@ fn loss_curves(
     let model = c.init_seeded(&cpu, init, None).unwrap();
     let on_gpu = model.clone().fork(&gpu_device);
     let (_, l_cpu) = train(model, c, data, 30, 3e-3, &cpu);
-    let _split = brdf_neural::batch_split::scope(parts);
+    let _split = brdf_neural::split_k::scope(parts);
     let (trained, l_gpu) = train(on_gpu, c, data, 30, 3e-3, &gpu_device);
     assert!(l_cpu[29] < 0.5 * l_cpu[0], "the CPU fit learns: {l_cpu:?}");
     (l_cpu, l_gpu, trained)
@@ -136,9 +136,9 @@ fn a_single_mlp_trains_along_the_same_loss_curve_on_the_gpu() {
 }
 
 #[test]
-fn the_batch_split_trains_along_the_same_loss_curve_on_the_gpu() {
+fn the_split_k_trains_along_the_same_loss_curve_on_the_gpu() {
     let c = small(ModelKind::SingleMlp);
-    // Two parts of 256 rows each: the split path (batch_split::MIN_ROWS).
+    // Two parts of 256 rows each: the split path (split_k::MIN_ROWS).
     let (l_cpu, l_gpu, _) = loss_curves(&c, &curve_data(&c, 9), 6, 2);
     assert_close(&l_gpu, &l_cpu, 1e-3, "loss curve with the batch split");
 }

@@ -1,7 +1,7 @@
 //! Where the time of a fit goes, per model kind: trains each run configuration of one scene of a
 //! finished sweep (for example the default's `out/reproduce`) for a fixed number of steps in a
 //! temporary directory, evaluates it, and prints milliseconds per step for each phase of the
-//! training step (`experiments::profile`) and seconds per phase of the evaluation.
+//! training step (`experiments::phases`) and seconds per phase of the evaluation.
 //!
 //! ```sh
 //! cargo xtask reproduce-tables            # once, for the scenes, caches and run configs

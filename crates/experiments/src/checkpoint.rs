@@ -39,7 +39,7 @@ pub struct CheckpointState {
     pub stopped: Option<crate::plateau::StopReason>,
     /// Seconds per phase of the step so far.
     #[serde(default)]
-    pub phases: crate::profile::StepPhases,
+    pub phases: crate::phases::StepPhases,
 }
 
 /// Writes a checkpoint atomically and removes the older ones; returns its folder.

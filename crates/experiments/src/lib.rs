@@ -8,7 +8,7 @@
 //!   split) and the plateau rule that decays the rate and stops a converged run.
 //! * [`train`], [`trainer`]: [`fit`] and its loop: validation, checkpoints, snapshots, resume
 //!   and non-finite detection.
-//! * [`profile`]: where a fit's time goes, per phase of the step.
+//! * [`phases`]: where a fit's and an evaluation's time goes, per phase (step timing).
 //! * [`checkpoint`], [`run_dir`]: what a run directory holds, written atomically.
 //! * [`eval`]: test renders, maps and every metric of a finished run.
 //! * [`export`]: a fitted model as a MERL-format table at one surface point.
@@ -42,8 +42,8 @@ pub mod eval;
 pub mod export;
 pub mod loss;
 mod loss_window;
+pub mod phases;
 pub mod plateau;
-pub mod profile;
 pub mod run_dir;
 pub mod sweep;
 pub mod train;

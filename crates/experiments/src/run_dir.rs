@@ -272,7 +272,7 @@ pub struct RunMetrics {
     /// Where the training time went, seconds per phase of the step (absent in runs trained
     /// before it was recorded).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub phases: Option<crate::profile::StepPhases>,
+    pub phases: Option<crate::phases::StepPhases>,
     /// The burn backend that trained the run (absent in runs trained before it was recorded).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub backend: Option<brdf_neural::device::Backend>,

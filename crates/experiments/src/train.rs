@@ -26,7 +26,7 @@ use crate::trainer::{
 };
 use crate::{Error, Result};
 use brdf_neural::precision::MatmulPrecision;
-use brdf_neural::{BrdfModel, batch_split};
+use brdf_neural::{BrdfModel, split_k};
 use burn::module::Module;
 use burn::optim::AdamConfig;
 use burn::tensor::Device;
@@ -272,8 +272,8 @@ pub fn fit_and_keep(
     }
     // On a GPU, the weight gradients' sum over the batch is split into parts (split-K): the
     // GPU's matrix-product kernels do not split it themselves. The CPU keeps the plain product.
-    let parts = if options.backend.is_gpu() { batch_split::gpu_parts(t.batch_size) } else { 1 };
-    let split = batch_split::scope(parts);
+    let parts = if options.backend.is_gpu() { split_k::gpu_parts(t.batch_size) } else { 1 };
+    let split = split_k::scope(parts);
     // burn and CubeCL panic when a GPU runs out of memory or is lost: end with an error that
     // says so and names the checkpoint that resumes, as for any other failure.
     let (hook, stop_after) = (options.hook, options.stop_after);

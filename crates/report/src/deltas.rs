@@ -13,8 +13,8 @@
 
 use super::average::{datasets, final_records, paired_delta};
 use super::record::{RunOptions, RunRecord};
+use super::result_tables::{caption, image_metrics};
 use super::table::{Column, ColumnGroup, Marking, Row, Table};
-use super::tables::{caption, image_metrics};
 use brdf_neural::{AngleParametrization, ModelKind, Reciprocity};
 
 /// One setting compared with the baseline.

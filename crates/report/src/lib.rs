@@ -8,7 +8,7 @@
 //!   deltas.
 //! * [`table`], [`rank`]: the table model and its highlighting (best / second / third,
 //!   improvements); [`markdown`] and [`latex`] render it.
-//! * [`tables`]: Table 1 in both protocols ([`Protocol`]: ours, with the noise ceiling, and
+//! * [`result_tables`]: Table 1 in both protocols ([`Protocol`]: ours, with the noise ceiling, and
 //!   the paper's), against the noise-free renders, reciprocity RMSE, energy conservation,
 //!   per-object tables.
 //! * [`paper`]: the paper's published Table 1 as data, ours beside it cell by cell under its
@@ -42,9 +42,9 @@ pub mod plot;
 pub mod rank;
 pub mod raster;
 pub mod record;
+pub mod result_tables;
 pub mod runtime;
 pub mod table;
-pub mod tables;
 
 pub use deltas::{
     Variant, nerfactor_deltas, nol_deltas, parametrization_deltas, reciprocity_deltas,
@@ -56,9 +56,9 @@ pub use latex::{LATEX_PREAMBLE, to_latex};
 pub use markdown::to_markdown;
 pub use plot::{LegendCorner, LinePlot, Series, line_plot_png};
 pub use record::{Dataset, Direction, MetricKind, RunOptions, RunRecord};
-pub use runtime::time_to_accuracy;
-pub use table::{Cell, Column, ColumnGroup, Marking, Row, Table};
-pub use tables::{
+pub use result_tables::{
     CEILING_LABEL, Protocol, energy_table, per_object_table, reciprocity_table, table1,
     table1_noise_free, table1_paper,
 };
+pub use runtime::time_to_accuracy;
+pub use table::{Cell, Column, ColumnGroup, Marking, Row, Table};

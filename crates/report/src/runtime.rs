@@ -9,8 +9,8 @@
 
 use super::average::objects;
 use super::record::{Dataset, Direction, MetricKind, RunOptions, RunRecord};
+use super::result_tables::caption;
 use super::table::{Cell, Column, ColumnGroup, Marking, Row, Table};
-use super::tables::caption;
 use brdf_neural::ModelKind;
 use metrics::aggregate::{PerObjectMean, Score};
 

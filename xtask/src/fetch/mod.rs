@@ -8,14 +8,14 @@
 //! hash in `<root>/fetch-lock.toml` so that later fetches verify against it. Failures of single
 //! files are collected; the command fails at the end naming each.
 
+mod checksum_ledger;
 mod http;
-mod lock;
 mod manifest;
 mod progress;
 mod unpack;
 
 use anyhow::{Context, Result, bail};
-use lock::{Lock, Locked};
+use checksum_ledger::{Lock, Locked};
 use manifest::{Entry, Manifest};
 use std::path::{Path, PathBuf};
 use std::time::Instant;

@@ -35,7 +35,7 @@ pub use settings::{EnergyEstimator, EvalConfig, EvalSettings};
 
 use crate::Result;
 use crate::data::TrainingData;
-use crate::profile::EvalPhases;
+use crate::phases::EvalPhases;
 use crate::run_dir::{RunDir, RunMetrics, Snapshot};
 use metrics::rmse::{CubeRootRmse, RmseConfig};
 use scene::SampleSet;

@@ -3,7 +3,7 @@
 
 use crate::data::TrainingData;
 use crate::{Error, Result};
-use brdf_neural::{BrdfModel, ModelConfig, Samples, batch_split};
+use brdf_neural::{BrdfModel, ModelConfig, Samples, split_k};
 use burn::tensor::{Device, Tensor};
 
 /// Rows per forward pass.
@@ -63,9 +63,9 @@ pub fn forward_rows(
 ) -> Result<Prediction> {
     let gpu = !brdf_neural::device::is_cpu_device(device);
     let rows = pass_rows(samples.l.len(), gpu);
-    // On a GPU, the training loop's parts of 512 rows (`batch_split::gpu_parts`): every pass of
+    // On a GPU, the training loop's parts of 512 rows (`split_k::gpu_parts`): every pass of
     // an evaluation then meets the matrix-product shapes that training tuned.
-    let _split = gpu.then(|| batch_split::scope(batch_split::gpu_parts(rows)));
+    let _split = gpu.then(|| split_k::scope(split_k::gpu_parts(rows)));
     forward_padded(model, config, samples, device, parts, rows)
 }
 

@@ -6,8 +6,8 @@ use super::agreement::kendall_tau_b;
 use super::data::{ModelGroup, PaperRange, PaperTable};
 use crate::average::{average, final_records};
 use crate::record::{Dataset, Direction, MetricKind, RunOptions, RunRecord};
+use crate::result_tables::{Protocol, caption};
 use crate::table::{Cell, Column, ColumnGroup, Marking, Row, Table};
-use crate::tables::{Protocol, caption};
 use brdf_neural::ModelKind;
 use metrics::aggregate::Score;
 

@@ -15,8 +15,8 @@ pub use findings::Finding;
 
 use crate::markdown::to_markdown;
 use crate::record::{Dataset, RunRecord};
+use crate::result_tables::Protocol;
 use crate::table::Table;
-use crate::tables::Protocol;
 
 /// Everything `tables/paper-vs-ours.md` shows.
 #[derive(Clone, Debug)]
