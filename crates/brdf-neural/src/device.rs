@@ -138,6 +138,16 @@ impl Backend {
             Backend::Cuda => {
                 #[cfg(feature = "cuda")]
                 {
+                    // CubeCL loads the driver on a thread of its own and panics there without
+                    // one; look for it first, for an error instead.
+                    if !cuda_driver_present() {
+                        return Err(crate::Error::BackendUnavailable(
+                            self,
+                            "no NVIDIA driver library (libcuda.so.1) could be loaded; \
+                             install the NVIDIA driver or use `--backend wgpu` or `cpu`"
+                                .into(),
+                        ));
+                    }
                     crate::gpu_cache::configure();
                     return Ok(Device::cuda(0usize));
                 }
@@ -150,6 +160,27 @@ impl Backend {
     pub fn training_device(self) -> crate::Result<Device> {
         Ok(self.device()?.autodiff())
     }
+}
+
+/// Whether the CUDA driver library can be loaded (what CubeCL's CUDA runtime needs first).
+#[cfg(feature = "cuda")]
+fn cuda_driver_present() -> bool {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    {
+        ["libcuda.so.1", "libcuda.so"].iter().any(|name| {
+            let name = std::ffi::CString::new(*name).expect("no NUL in the name");
+            // SAFETY: a NUL-terminated name; the handle is only tested, then released.
+            let handle = unsafe { libc::dlopen(name.as_ptr(), libc::RTLD_LAZY | libc::RTLD_LOCAL) };
+            if handle.is_null() {
+                return false;
+            }
+            // SAFETY: the handle dlopen just returned.
+            unsafe { libc::dlclose(handle) };
+            true
+        })
+    }
+    #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+    true
 }
 
 /// Whether `device` (with or without autodiff) is a CPU backend's device (flex or ndarray);

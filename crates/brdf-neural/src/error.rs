@@ -21,6 +21,9 @@ pub enum Error {
         "backend {0} is not built in: rebuild with `--features {0}` (e.g. `cargo build --release -p xtask --features {0}`)"
     )]
     BackendNotBuilt(Backend),
+    /// A GPU backend that is built in but cannot run here (no driver).
+    #[error("backend {0} cannot run here: {1}")]
+    BackendUnavailable(Backend, String),
     /// Sample arrays whose lengths disagree.
     #[error("batch shape: {0}")]
     BatchShape(String),
