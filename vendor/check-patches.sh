@@ -23,8 +23,13 @@ check() {
     if [ -n "$cached" ]; then
         cp "$cached" "$crate"
     else
-        curl -sSfL --retry 3 -o "$crate" \
-            "https://static.crates.io/crates/$name/$name-$version.crate"
+        local url="https://static.crates.io/crates/$name/$name-$version.crate"
+        if command -v curl >/dev/null; then
+            curl -sSfL --retry 3 -o "$crate" "$url"
+        else
+            python3 -c 'import sys, urllib.request; urllib.request.urlretrieve(sys.argv[1], sys.argv[2])' \
+                "$url" "$crate"
+        fi
     fi
     echo "$sha256  $crate" | sha256sum --check --quiet
     mkdir -p "$tmp/a"
