@@ -6,8 +6,7 @@
 # CI runs it (`.ci/run`). To change a patch: edit the vendored copy, then regenerate the file
 # with `bash vendor/check-patches.sh --write`.
 #
-# Covered: cubecl-cuda. Not yet: burn-flex and burn-dispatch, hand-patched copies without
-# patch files (the architecture issue).
+# Covered: every vendored crate (burn-flex, cubecl-cuda).
 set -euo pipefail
 cd "$(dirname "$0")"
 write=${1:-}
@@ -32,25 +31,29 @@ check() {
         fi
     fi
     echo "$sha256  $crate" | sha256sum --check --quiet
-    mkdir -p "$tmp/a"
-    tar -xzf "$crate" -C "$tmp/a"
+    local work="$tmp/$name"
+    mkdir -p "$work/a"
+    tar -xzf "$crate" -C "$work/a"
     if [ "$write" = --write ]; then
-        mkdir -p "$tmp/pair"
-        mv "$tmp/a/$name-$version" "$tmp/pair/a"
-        cp -r "$name" "$tmp/pair/b"
-        (cd "$tmp/pair" && diff -ruN a b >"$OLDPWD/$patch" || true)
+        mkdir -p "$work/pair"
+        mv "$work/a/$name-$version" "$work/pair/a"
+        cp -r "$name" "$work/pair/b"
+        (cd "$work/pair" && diff -ruN a b >"$OLDPWD/$patch" || true)
         sed -i -E 's/^(---|\+\+\+) ([^\t]+)\t.*/\1 \2/' "$patch"
         echo "vendor: wrote $patch ($(wc -l <"$patch") lines)"
         return
     fi
-    (cd "$tmp/a/$name-$version" && git apply -p1 "$OLDPWD/$patch")
-    if ! diff -r "$tmp/a/$name-$version" "$name"; then
+    (cd "$work/a/$name-$version" && git apply -p1 "$OLDPWD/$patch")
+    if ! diff -r "$work/a/$name-$version" "$name"; then
         echo "vendor: $name differs from $name $version plus $patch (above)" >&2
         return 1
     fi
     echo "vendor: $name is $name $version plus $patch ($(grep -c '^[-+][^-+]' "$patch") changed lines)"
 }
 
+# Aligned output buffers, element-wise work on both cores, strided unary and scalar ops (the
+# linear layers' kernels live in crates/cpu-kernels, reached through a backend extension).
+check burn-flex 0.22.1 7e05d08ef48d738fadf13f8689b634f8b396d5a8cbb27d0a87f61e163d241846
 # Without its LLVM backend (`cubecl-llvm`, whose build script downloads an LLVM bundle from
 # GitHub), so that `--features cuda` builds offline; kernels compile through NVRTC.
 check cubecl-cuda 0.11.3 dacd0c047f781b468d094705ef042f28d68944bf862c049f5cf0b7396f730bb5

@@ -129,11 +129,12 @@ enum Command {
         /// `--features wgpu` or `cuda`). On a GPU, use `--jobs 1`.
         #[arg(long, default_value = "cpu", value_parser = parse_backend)]
         backend: Backend,
-        /// Precision of the training steps' matrix products: `f32` (default) or `bf16` (CPU
-        /// backend; about 1.5x faster fits on AVX512-BF16 CPUs, see README). bf16 runs get
-        /// their own run ids.
-        #[arg(long, default_value = "f32", value_parser = parse_precision)]
-        matmul_precision: MatmulPrecision,
+        /// Precision of the training steps' matrix products, for every run: `f32` or `bf16`
+        /// (CPU backend; about 1.5x faster fits on AVX512-BF16 CPUs, see README). Without it,
+        /// the profile's `run.train.matmul_precision` holds (f32 unless it says otherwise).
+        /// bf16 runs get their own run ids.
+        #[arg(long, value_parser = parse_precision)]
+        matmul_precision: Option<MatmulPrecision>,
     },
     /// Build every table and figure from the evaluated run directories below PATHS.
     Collect {

@@ -21,8 +21,9 @@ pub struct Options {
     pub data_root: PathBuf,
     /// The burn backend every run trains and evaluates on.
     pub backend: Backend,
-    /// Precision of every run's training matrix products (`train.matmul_precision`).
-    pub matmul_precision: MatmulPrecision,
+    /// Precision of every run's training matrix products (`train.matmul_precision`), where
+    /// given; `None` keeps the profile's.
+    pub matmul_precision: Option<MatmulPrecision>,
 }
 
 /// The data root: `NEURAL_BRDF_DATA`, else `./data`.
@@ -44,12 +45,14 @@ pub fn reproduce(opts: Options) -> Result<()> {
         opts.backend
     );
     anyhow::ensure!(
-        opts.matmul_precision == MatmulPrecision::F32 || opts.backend == Backend::Flex,
+        opts.matmul_precision != Some(MatmulPrecision::Bf16) || opts.backend == Backend::Flex,
         "--matmul-precision bf16 is implemented for the CPU backend only, not --backend {}",
         opts.backend
     );
-    let profile =
-        SweepProfile::load(&opts.profile)?.with_matmul_precision(opts.matmul_precision)?;
+    let mut profile = SweepProfile::load(&opts.profile)?;
+    if let Some(precision) = opts.matmul_precision {
+        profile = profile.with_matmul_precision(precision)?;
+    }
     eprintln!("profile {}: {}", profile.name, profile.description);
     // One sweep at a time per output directory, held through the tables; taking it removes
     // the temporary files of a sweep killed in it (run directories busy in another process

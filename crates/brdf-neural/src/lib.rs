@@ -74,8 +74,11 @@ pub mod device;
 mod error;
 pub mod features;
 pub mod finite_check;
+#[cfg(feature = "flex")]
+mod flex_linear;
 pub mod gpu_cache;
 pub mod host_memory;
+pub mod linear_op;
 pub mod mlp;
 pub mod model;
 pub mod output;

@@ -5,17 +5,25 @@
 //! products are rounded to bfloat16 (8 significant bits), the products summed in f32; weights,
 //! activations, gradients and Adam stay f32. On Intel CPUs with AMX the products run on its tiles
 //! (`tdpbf16ps`), on other CPUs with AVX512-BF16 at twice the multiply-adds per instruction of
-//! f32 (`vdpbf16ps`), both in the patched flex backend; elsewhere the same rounding is emulated,
+//! f32 (`vdpbf16ps`), both in the `cpu-kernels` crate; elsewhere the same rounding is emulated,
 //! slower than f32. Only the flex CPU backend implements it.
 //!
-//! The setting is per thread: [`MatmulPrecision::scope`] applies it to the products the calling
-//! thread issues until the returned guard drops, so an evaluation on another thread (or after
-//! the fit) keeps f32; [`MatmulPrecision::f32_scope`] returns to f32 inside a bf16 scope (the
-//! training loop's validation loss, which decides the plateau schedule, is f32). Products that
-//! gain nothing (narrow heads such as the 3-channel output, small or batched products) stay
+//! The setting belongs to the training loop of one thread: [`MatmulPrecision::scope`] applies
+//! it to the linear layers of the models that thread runs until the returned guard drops, so an
+//! evaluation on another thread (or after the fit) keeps f32; [`MatmulPrecision::f32_scope`]
+//! returns to f32 inside a bf16 scope (the training loop's validation loss, which decides the
+//! plateau schedule, is f32). The layers read it when they run ([`MatmulPrecision::current`])
+//! and hand it to the kernels as an argument of each product ([`crate::linear_op`]), which keep
+//! it for the product's backward pass; no other matrix product in the process is affected.
+//! Products that gain nothing (narrow heads such as the 3-channel output, small products) stay
 //! f32.
 
 use serde::{Deserialize, Serialize};
+use std::cell::Cell;
+
+thread_local! {
+    static CURRENT: Cell<MatmulPrecision> = const { Cell::new(MatmulPrecision::F32) };
+}
 
 /// How the f32 matrix products of a training step are computed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -61,6 +69,12 @@ impl MatmulPrecision {
         PrecisionGuard { previous: Some(set(MatmulPrecision::F32)) }
     }
 
+    /// The precision of the linear layers the calling thread runs now (f32 outside a
+    /// [`MatmulPrecision::scope`]).
+    pub fn current() -> MatmulPrecision {
+        CURRENT.with(Cell::get)
+    }
+
     /// Whether this CPU has Intel's AMX-BF16 tile unit (Xeons from Sapphire Rapids on; CPUID
     /// leaf 7, EDX bit 22). The flex backend's bf16 products run on it when Linux grants the
     /// tile registers ([`MatmulPrecision::bf16_on_amx`]); without it they take the AVX512-BF16
@@ -79,11 +93,11 @@ impl MatmulPrecision {
     }
 
     /// Whether the bf16 products run on AMX tiles here (the flex backend's AMX kernel: the CPU
-    /// has AMX-BF16 and Linux granted the tile registers; `BURN_FLEX_AMX=0` turns it off).
+    /// has AMX-BF16 and Linux granted the tile registers; `CPU_KERNELS_AMX=0` turns it off).
     pub fn bf16_on_amx() -> bool {
         #[cfg(feature = "flex")]
         {
-            burn_flex::bf16_amx_active()
+            cpu_kernels::bf16_amx_active()
         }
         #[cfg(not(feature = "flex"))]
         {
@@ -95,7 +109,7 @@ impl MatmulPrecision {
     /// AVX-512 kernel, process-wide: for benchmarks and tests that compare the two.
     pub fn set_bf16_amx_enabled(enabled: bool) {
         #[cfg(feature = "flex")]
-        burn_flex::set_bf16_amx_enabled(enabled);
+        cpu_kernels::set_bf16_amx_enabled(enabled);
         #[cfg(not(feature = "flex"))]
         let _ = enabled;
     }
@@ -104,7 +118,7 @@ impl MatmulPrecision {
     pub fn bf16_native() -> bool {
         #[cfg(feature = "flex")]
         {
-            burn_flex::bf16_dot_native()
+            cpu_kernels::bf16_dot_native()
         }
         #[cfg(not(feature = "flex"))]
         {
@@ -127,21 +141,8 @@ impl Drop for PrecisionGuard {
     }
 }
 
-#[cfg(feature = "flex")]
 fn set(p: MatmulPrecision) -> MatmulPrecision {
-    let flex = match p {
-        MatmulPrecision::F32 => burn_flex::MatmulPrecision::Highest,
-        MatmulPrecision::Bf16 => burn_flex::MatmulPrecision::Bf16,
-    };
-    match burn_flex::set_f32_matmul_precision(flex) {
-        burn_flex::MatmulPrecision::Highest => MatmulPrecision::F32,
-        burn_flex::MatmulPrecision::Bf16 => MatmulPrecision::Bf16,
-    }
-}
-
-#[cfg(not(feature = "flex"))]
-fn set(_: MatmulPrecision) -> MatmulPrecision {
-    MatmulPrecision::F32
+    CURRENT.with(|c| c.replace(p))
 }
 
 #[cfg(test)]

@@ -61,12 +61,18 @@ impl Drop for BatchSplitGuard {
 }
 
 /// `layer` applied to `x` (`[rows, d_in]` to `[rows, d_out]`), split as the thread's
-/// [`scope`] says.
+/// [`scope`] says; unsplit, through [`crate::linear_op::linear`] in the thread's
+/// [`MatmulPrecision::current`](crate::precision::MatmulPrecision::current).
 pub(crate) fn linear(layer: &Linear, x: Tensor<2>) -> Tensor<2> {
     let parts = parts();
     let [rows, d_in] = x.dims();
     if parts <= 1 || !rows.is_multiple_of(parts) || rows / parts < MIN_ROWS {
-        return layer.forward(x);
+        // The weight first: lazily initialised parameters draw their values at their first
+        // `val()`, in the order burn's `Linear::forward` reads them.
+        let weight = layer.weight.val();
+        let bias = layer.bias.as_ref().map(|b| b.val());
+        let precision = crate::precision::MatmulPrecision::current();
+        return crate::linear_op::linear(x, weight, bias, precision);
     }
     let weight = layer.weight.val();
     let d_out = weight.dims()[1];

@@ -1,11 +1,13 @@
 //! The CPU backend as this workspace builds it: flex with the patches in `vendor/burn-flex`
-//! and the host-memory policy.
+//! (`vendor/patches/burn-flex-0.22.1.patch`), the host-memory policy, and the linear layers'
+//! products in the `cpu-kernels` crate.
 //!
 //! Matrix products and their gradients are compared with f64 references for output sizes on
 //! both sides of the alignment patch (byte sizes that are and are not multiples of 16), for
 //! plain and transposed (strided) operands, and across repeated allocate-and-free cycles as a
-//! training step makes them. Products split over k (patch 4) and element-wise ops spread over
-//! the threads (patch 5) are checked against f64 and scalar references and for giving the same
+//! training step makes them. Weight-gradient products split over k (`cpu_kernels::split_k`,
+//! through `brdf_neural::linear_op`) and element-wise ops spread over the threads (patch 5) are
+//! checked against f64 and scalar references and for giving the same
 //! bits on 1, 2 and 3 threads.
 
 use brdf_neural::device;
@@ -102,8 +104,9 @@ fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
 
 #[test]
 fn long_products_split_over_k_match_f64_and_not_the_thread_count() {
-    // A weight gradient's shape, Xᵀ dY summed over a batch of k rows: vendor/burn-flex patch
-    // 4 sums k in blocks (2 at 9,000, 4 at 16,411), on both sides of the block threshold.
+    // A weight gradient's shape, Xᵀ dY summed over a batch of k rows, as a linear layer
+    // computes it: `cpu_kernels::split_k` sums k in blocks (2 at 9,000, 4 at 16,411), on both
+    // sides of the block threshold.
     let d = device::cpu();
     for (k, m, n) in [(8_191, 5, 16), (9_000, 7, 19), (16_411, 33, 128)] {
         let x = values(k * m, k as u64);
@@ -113,7 +116,9 @@ fn long_products_split_over_k_match_f64_and_not_the_thread_count() {
         let product = || {
             let tx = Tensor::<2>::from_data(TensorData::new(x.clone(), [k, m]), &d);
             let tdy = Tensor::<2>::from_data(TensorData::new(dy.clone(), [k, n]), &d);
-            tx.transpose().matmul(tdy).into_data().try_to_vec::<f32>().unwrap()
+            let f32 = brdf_neural::precision::MatmulPrecision::F32;
+            let y = brdf_neural::linear_op::linear(tx.transpose(), tdy, None, f32);
+            y.into_data().try_to_vec::<f32>().unwrap()
         };
         let one = on_threads(1, product);
         assert_close(&one, &want, &format!("[{k}, {m}]ᵀ x [{k}, {n}]"));

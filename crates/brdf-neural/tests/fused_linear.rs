@@ -1,16 +1,17 @@
-//! Linear layers with the bias added in the matrix product's store (vendor/burn-flex patch 8,
-//! reached through vendor/burn-dispatch's forwarding of `linear`).
+//! The models' linear layers (`brdf_neural::linear_op`, the `cpu-kernels` crate behind a burn
+//! backend extension) with the bias added in the matrix product's store.
 //!
 //! A layer's value and its gradients must be those of the unfused form, the product followed
-//! by a broadcast add, to the bit: in f32 (the gemm in blocks of rows) and in bf16 (the AMX
-//! kernel's block store, and the AVX-512 kernel or the emulation with the add after), for
-//! shapes with tails in every dimension, outputs narrower than the fused path takes, and inputs
-//! with leading dimensions.
+//! by a broadcast add, to the bit: in f32 (the gemm in blocks of rows) also against burn-flex's
+//! own product, and in bf16 (the AMX kernel's block store, and the AVX-512 kernel or the
+//! emulation with the add after), for shapes with tails in every dimension and outputs narrower
+//! than the fused path takes; the gradients through the extension's autodiff node against
+//! burn's autodiff of the product and the add.
 #![cfg(feature = "flex")]
 
 use brdf_neural::device::{self, Backend};
+use brdf_neural::linear_op::linear;
 use brdf_neural::precision::MatmulPrecision;
-use burn::tensor::module::linear;
 use burn::tensor::{Tensor, TensorData};
 
 /// Deterministic values in [-1, 1).
@@ -53,39 +54,43 @@ fn assert_same_bits(got: &[u32], want: &[u32], what: &str) {
     }
 }
 
-/// The layer through `linear` and as product plus broadcast add, as bit patterns.
-fn fused_and_plain(m: usize, k: usize, n: usize, seed: u64) -> (Vec<u32>, Vec<u32>) {
+/// The layer with the bias fused, the layer without bias plus a broadcast add, and burn-flex's
+/// own product plus the add, as bit patterns, in the calling thread's precision.
+fn fused_and_plain(m: usize, k: usize, n: usize, seed: u64) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
     let d = device::cpu();
     let x = Tensor::<2>::from_data(TensorData::new(values(m * k, seed), [m, k]), &d);
     let w = Tensor::<2>::from_data(TensorData::new(values(k * n, seed + 1), [k, n]), &d);
     let b = Tensor::<1>::from_data(TensorData::new(values(n, seed + 2), [n]), &d);
-    let fused = linear(x.clone(), w.clone(), Some(b.clone()));
-    let plain = x.matmul(w) + b.unsqueeze::<2>();
-    (bits(fused), bits(plain))
+    let p = MatmulPrecision::current();
+    let fused = linear(x.clone(), w.clone(), Some(b.clone()), p);
+    let plain = linear(x.clone(), w.clone(), None, p) + b.clone().unsqueeze::<2>();
+    let flex = x.matmul(w) + b.unsqueeze::<2>();
+    (bits(fused), bits(plain), bits(flex))
 }
 
 #[test]
 fn f32_linear_layers_equal_the_product_plus_the_bias_to_the_bit() {
     for (i, &(m, k, n)) in SHAPES.iter().enumerate() {
-        let (fused, plain) = fused_and_plain(m, k, n, 10 * i as u64);
+        let (fused, plain, flex) = fused_and_plain(m, k, n, 10 * i as u64);
         assert_same_bits(&fused, &plain, &format!("[{m}, {k}] x [{k}, {n}] + b"));
+        assert_same_bits(&fused, &flex, &format!("[{m}, {k}] x [{k}, {n}] + b against flex"));
     }
 }
 
 #[test]
 fn bf16_linear_layers_equal_the_product_plus_the_bias_to_the_bit() {
-    let kernels = if burn_flex::bf16_amx_active() { vec![true, false] } else { vec![false] };
+    let kernels = if MatmulPrecision::bf16_on_amx() { vec![true, false] } else { vec![false] };
     for amx in kernels {
         // Process-wide; the other tests here run f32, which no bf16 kernel touches.
-        burn_flex::set_bf16_amx_enabled(amx);
+        MatmulPrecision::set_bf16_amx_enabled(amx);
         let _g = MatmulPrecision::Bf16.scope(Backend::Flex).unwrap();
         for (i, &(m, k, n)) in SHAPES.iter().enumerate() {
-            let (fused, plain) = fused_and_plain(m, k, n, 100 + 10 * i as u64);
+            let (fused, plain, _) = fused_and_plain(m, k, n, 100 + 10 * i as u64);
             let what = format!("bf16 (AMX: {amx}) [{m}, {k}] x [{k}, {n}] + b");
             assert_same_bits(&fused, &plain, &what);
         }
     }
-    burn_flex::set_bf16_amx_enabled(true);
+    MatmulPrecision::set_bf16_amx_enabled(true);
 }
 
 #[test]
@@ -100,7 +105,7 @@ fn linear_layer_gradients_equal_the_unfused_gradients_to_the_bit() {
             Tensor::<2>::from_data(TensorData::new(values(k * n, 2), [k, n]), &d).require_grad();
         let b = Tensor::<1>::from_data(TensorData::new(values(n, 3), [n]), &d).require_grad();
         let y = if fused {
-            linear(x.clone(), w.clone(), Some(b.clone()))
+            linear(x.clone(), w.clone(), Some(b.clone()), MatmulPrecision::F32)
         } else {
             x.clone().matmul(w.clone()) + b.clone().unsqueeze::<2>()
         };
@@ -114,17 +119,4 @@ fn linear_layer_gradients_equal_the_unfused_gradients_to_the_bit() {
     assert_same_bits(&fused.1, &plain.1, "dL/dx");
     assert_same_bits(&fused.2, &plain.2, "dL/dW");
     assert_same_bits(&fused.3, &plain.3, "dL/db");
-}
-
-#[test]
-fn leading_dimensions_fold_into_the_rows() {
-    let d = device::cpu();
-    let (k, n) = (24, 32);
-    let x = Tensor::<3>::from_data(TensorData::new(values(3 * 50 * k, 5), [3, 50, k]), &d);
-    let w = Tensor::<2>::from_data(TensorData::new(values(k * n, 6), [k, n]), &d);
-    let b = Tensor::<1>::from_data(TensorData::new(values(n, 8), [n]), &d);
-    let y = linear(x.clone(), w.clone(), Some(b.clone()));
-    assert_eq!(y.dims(), [3, 50, n]);
-    let rows = linear(x.reshape([150, k]), w, Some(b));
-    assert_same_bits(&bits(y.reshape([150, n])), &bits(rows), "[3, 50, k] against [150, k]");
 }

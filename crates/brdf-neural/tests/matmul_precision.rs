@@ -83,7 +83,12 @@ fn product(a: &[f32], b: &[f32], m: usize, k: usize, n: usize, layout: Layout) -
         }
         _ => Tensor::from_data(TensorData::new(b.to_vec(), [k, n]), &device),
     };
-    lhs.matmul(rhs).into_data().try_to_vec::<f32>().unwrap()
+    // A linear layer without bias: the products the models' layers issue, in the precision of
+    // the calling thread's scope.
+    brdf_neural::linear_op::linear(lhs, rhs, None, MatmulPrecision::current())
+        .into_data()
+        .try_to_vec::<f32>()
+        .unwrap()
 }
 
 fn max_scaled_error(got: &[f32], want: &[f64], scale: &[f64]) -> f64 {
@@ -108,18 +113,18 @@ const SHAPES: [(usize, usize, usize); 7] = [
 /// The bf16 kernels this machine can run: AMX tiles (where the CPU and the OS allow them) and
 /// the AVX-512 kernel, or the one it has.
 fn kernels() -> Vec<bool> {
-    if burn_flex::bf16_amx_active() { vec![true, false] } else { vec![false] }
+    if MatmulPrecision::bf16_on_amx() { vec![true, false] } else { vec![false] }
 }
 
 #[test]
 fn bf16_products_equal_the_rounded_operands_product() {
     for amx in kernels() {
         // Process-wide; the other tests here are indifferent to which bf16 kernel runs.
-        burn_flex::set_bf16_amx_enabled(amx);
-        assert_eq!(burn_flex::bf16_amx_active(), amx);
+        MatmulPrecision::set_bf16_amx_enabled(amx);
+        assert_eq!(MatmulPrecision::bf16_on_amx(), amx);
         check_bf16_products(amx);
     }
-    burn_flex::set_bf16_amx_enabled(true);
+    MatmulPrecision::set_bf16_amx_enabled(true);
 }
 
 fn check_bf16_products(amx: bool) {
@@ -186,7 +191,7 @@ fn the_emulation_for_cpus_without_bf16_agrees() {
         let mut r = rng(m as u64);
         let a: Vec<f32> = (0..m * k).map(|_| r()).collect();
         let b: Vec<f32> = (0..k * n).map(|_| r()).collect();
-        let got = burn_flex::ops::matmul_bf16dot::emulated_row_major(m, n, k, &a, &b);
+        let got = cpu_kernels::emulated_row_major(m, n, k, &a, &b);
         let (want, scale) = reference(&a, &b, m, k, n, bf16);
         let err = max_scaled_error(&got, &want, &scale);
         assert!(err < 4e-6 * (k as f64).sqrt(), "{m}x{k}x{n}: emulated error {err:e}");

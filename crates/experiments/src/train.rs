@@ -264,7 +264,7 @@ pub fn fit_and_keep(
     {
         eprintln!(
             "{}: warning: matmul_precision = \"bf16\" on an Intel CPU with AMX, but the AMX \
-             kernel is off (BURN_FLEX_AMX=0, or Linux refused the tile registers): the products \
+             kernel is off (CPU_KERNELS_AMX=0, or Linux refused the tile registers): the products \
              run on AVX512-BF16, measured 1.3x slower a step than f32 on such a Xeon \
              (benches/README.md); f32 is likely the faster choice here",
             run.display()

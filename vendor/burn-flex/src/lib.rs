@@ -44,11 +44,6 @@ pub mod ops;
 pub mod simd;
 
 pub use backend::{Flex, FlexDevice};
-#[cfg(feature = "std")]
-pub use ops::matmul_bf16dot::{
-    MatmulPrecision, bf16_amx_active, bf16_dot_native, f32_matmul_precision,
-    set_bf16_amx_enabled, set_f32_matmul_precision,
-};
 pub use layout::Layout;
 pub use qtensor::FlexQTensor;
 pub use tensor::FlexTensor;

@@ -21,7 +21,10 @@ pub struct FixedLinear {
 
 impl FixedLinear {
     fn forward(&self, x: Tensor<2>) -> Tensor<2> {
-        x.matmul(self.weight.clone()) + self.bias.clone()
+        let [_, n] = self.bias.dims();
+        let bias = self.bias.clone().reshape([n]);
+        let precision = crate::precision::MatmulPrecision::current();
+        crate::linear_op::linear(x, self.weight.clone(), Some(bias), precision)
     }
 }
 
@@ -129,8 +132,12 @@ impl FmbrdfNets {
             &device,
         );
         let index = Tensor::<1, Int>::from_data(TensorData::new(segments.of_row, [n]), &device);
-        let p = (mask.clone() * a).matmul(second.weight.clone());
-        let q = (mask * c).matmul(second.weight.clone());
+        let product = |x: Tensor<2>| {
+            let precision = crate::precision::MatmulPrecision::current();
+            crate::linear_op::linear(x, second.weight.clone(), None, precision)
+        };
+        let p = product(mask.clone() * a);
+        let q = product(mask * c);
         let z2 = p.select(0, index.clone()) + tan * q.select(0, index) + second.bias.clone();
         self.lambda[2..].iter().fold(relu(z2), |h, layer| relu(layer.forward(h)))
     }
@@ -157,8 +164,10 @@ impl FmbrdfNets {
     ///   (eta, alpha, beta, kappa)
     /// - output: `[n, 1]`, >= 0
     pub fn body(&self, geometry: Tensor<2>, params: Tensor<2>) -> Tensor<2> {
-        let mut h =
-            relu(geometry.matmul(self.body_geometry.clone()) + self.body_params.forward(params));
+        let precision = crate::precision::MatmulPrecision::current();
+        let geometry =
+            crate::linear_op::linear(geometry, self.body_geometry.clone(), None, precision);
+        let mut h = relu(geometry + self.body_params.forward(params));
         let last = self.body.len() - 1;
         for (k, layer) in self.body.iter().enumerate() {
             h = layer.forward(h);

@@ -97,220 +97,12 @@ pub fn matmul(lhs: FlexTensor, rhs: FlexTensor) -> FlexTensor {
     assert_eq!(k_lhs, k_rhs, "matmul: inner dimensions must match");
 
     match lhs.dtype() {
-        DType::F32 => {
-            #[cfg(feature = "std")]
-            if let Some(out) = matmul_f32_bf16dot(&lhs, &rhs, None) {
-                return out;
-            }
-            if let Some(out) = matmul_f32_split_k(&lhs, &rhs) {
-                return out;
-            }
-            matmul_gemm::<f32>(lhs, rhs)
-        }
+        DType::F32 => matmul_gemm::<f32>(lhs, rhs),
         DType::F64 => matmul_gemm::<f64>(lhs, rhs),
         DType::F16 => matmul_gemm::<f16>(lhs, rhs),
         DType::BF16 => matmul_bf16(lhs, rhs),
         _ => panic!("matmul: unsupported dtype {:?}", lhs.dtype()),
     }
-}
-
-/// An f32 product of two matrices through bf16 dot products, when this thread asked for them
-/// ([`crate::set_f32_matmul_precision`]) and the product is large and wide enough to gain;
-/// `None` leaves it to the f32 gemm (batched, narrow outputs such as a 3-channel head, small).
-#[cfg(feature = "std")]
-fn matmul_f32_bf16dot(
-    lhs: &FlexTensor,
-    rhs: &FlexTensor,
-    bias: Option<&[f32]>,
-) -> Option<FlexTensor> {
-    use crate::ops::matmul_bf16dot::{MatRef, MatmulPrecision, f32_matmul_precision};
-    if f32_matmul_precision() != MatmulPrecision::Bf16 {
-        return None;
-    }
-    let (ls, rs) = (lhs.layout().shape(), rhs.layout().shape());
-    if ls.num_dims() != 2 || rs.num_dims() != 2 {
-        return None;
-    }
-    let (m, k, n) = (ls[0], ls[1], rs[1]);
-    if n < 16 || k < 8 || m.saturating_mul(n).saturating_mul(k) < 1 << 18 {
-        return None;
-    }
-    let (lrs, lcs) = get_2d_strides(lhs.layout());
-    let (rrs, rcs) = get_2d_strides(rhs.layout());
-    let ldata: &[f32] = lhs.storage();
-    let rdata: &[f32] = rhs.storage();
-    let a = MatRef { ptr: unsafe { ldata.as_ptr().add(lhs.layout().start_offset()) }, rs: lrs, cs: lcs };
-    let b = MatRef { ptr: unsafe { rdata.as_ptr().add(rhs.layout().start_offset()) }, rs: rrs, cs: rcs };
-    // SAFETY: `matmul_bf16dot` writes every element of its m x n output.
-    Some(unsafe {
-        output_written_by::<f32>(m, n, |out| {
-            crate::ops::matmul_bf16dot::matmul_bf16dot(m, n, k, a, b, out, bias)
-        })
-    })
-}
-
-/// An f32 product with a long inner dimension and a small output (a weight gradient), summed
-/// in blocks of k in parallel (patch 4, [`crate::ops::matmul_split_k`]); `None` for every
-/// other product.
-fn matmul_f32_split_k(lhs: &FlexTensor, rhs: &FlexTensor) -> Option<FlexTensor> {
-    use crate::ops::matmul_split_k::{Operand, matmul_split_k, split_k_blocks};
-    let (ls, rs) = (lhs.layout().shape(), rhs.layout().shape());
-    if ls.num_dims() != 2 || rs.num_dims() != 2 {
-        return None;
-    }
-    let (m, k, n) = (ls[0], ls[1], rs[1]);
-    let blocks = split_k_blocks(m, n, k);
-    if blocks <= 1 {
-        return None;
-    }
-    let (lrs, lcs) = get_2d_strides(lhs.layout());
-    let (rrs, rcs) = get_2d_strides(rhs.layout());
-    let ldata: &[f32] = lhs.storage();
-    let rdata: &[f32] = rhs.storage();
-    let a = Operand { ptr: unsafe { ldata.as_ptr().add(lhs.layout().start_offset()) }, rs: lrs, cs: lcs };
-    let b = Operand { ptr: unsafe { rdata.as_ptr().add(rhs.layout().start_offset()) }, rs: rrs, cs: rcs };
-    // SAFETY: `matmul_split_k` writes every element of its m x n output.
-    Some(unsafe { output_written_by::<f32>(m, n, |out| matmul_split_k(m, n, k, blocks, a, b, out)) })
-}
-
-/// `lhs rhs + bias` for f32 matrices (`bias` one value per column), with the bias added to each
-/// block of output rows while it is still in cache (patch 8, for `linear`): no separate pass
-/// over the output. The values are those of the product followed by burn's broadcast add, to the
-/// bit: the same kernels, the same sums, the same f32 addition. `None` where the fused path does
-/// not apply (not f32, not 2D, a bias that is not n contiguous values, narrow outputs, products
-/// that take the split-k path); the caller then adds the bias itself.
-pub(crate) fn matmul_bias(
-    lhs: &FlexTensor,
-    rhs: &FlexTensor,
-    bias: &FlexTensor,
-) -> Option<FlexTensor> {
-    let f32s = [lhs.dtype(), rhs.dtype(), bias.dtype()].iter().all(|d| *d == DType::F32);
-    let (ls, rs, bs) = (lhs.layout().shape(), rhs.layout().shape(), bias.layout().shape());
-    if !f32s || ls.num_dims() != 2 || rs.num_dims() != 2 || bs.num_dims() != 1 {
-        return None;
-    }
-    let (m, k, n) = (ls[0], ls[1], rs[1]);
-    if rs[0] != k || bs[0] != n || n < 16 || m == 0 || k == 0 {
-        return None;
-    }
-    let (b0, b1) = bias.layout().contiguous_offsets()?;
-    let bias_values: &[f32] = &bias.storage()[b0..b1];
-    #[cfg(feature = "std")]
-    if let Some(out) = matmul_f32_bf16dot(lhs, rhs, Some(bias_values)) {
-        return Some(out);
-    }
-    if crate::ops::matmul_split_k::split_k_blocks(m, n, k) > 1 {
-        return None;
-    }
-    let (lrs, lcs) = get_2d_strides(lhs.layout());
-    let (rrs, rcs) = get_2d_strides(rhs.layout());
-    let ldata: &[f32] = lhs.storage();
-    let rdata: &[f32] = rhs.storage();
-    let lptr = unsafe { ldata.as_ptr().add(lhs.layout().start_offset()) };
-    let rptr = unsafe { rdata.as_ptr().add(rhs.layout().start_offset()) };
-    // SAFETY: every block of rows is written by gemm (`read_dst = false`), then read back.
-    Some(unsafe {
-        output_written_by::<f32>(m, n, |out| {
-            gemm_bias_by_rows(m, n, k, lptr, lrs, lcs, rptr, rrs, rcs, bias_values, out)
-        })
-    })
-}
-
-/// Rows of output per block of [`gemm_bias_by_rows`]: about 512 KB of output, so a block and
-/// its share of the left operand stay in L2 until the bias is added.
-fn bias_block_rows(n: usize) -> usize {
-    ((1usize << 17) / n).clamp(64, 4096)
-}
-
-/// out = lhs rhs + bias, in blocks of [`bias_block_rows`] rows, each a single-threaded gemm
-/// followed by the bias add on the still-hot block; the blocks run in parallel. A row's value
-/// does not depend on the block it falls in (gemm sums every output over the same k blocks),
-/// so this equals the whole-matrix gemm and a separate add.
-///
-/// # Safety
-/// The pointers address an m x k and a k x n matrix with these strides, `out` m * n floats.
-#[allow(clippy::too_many_arguments)]
-unsafe fn gemm_bias_by_rows(
-    m: usize,
-    n: usize,
-    k: usize,
-    lhs: *const f32,
-    lrs: isize,
-    lcs: isize,
-    rhs: *const f32,
-    rrs: isize,
-    rcs: isize,
-    bias: &[f32],
-    out: *mut f32,
-) {
-    struct Ptrs(*const f32, *const f32, *mut f32);
-    // SAFETY: the blocks write disjoint rows of `out` and only read the operands.
-    unsafe impl Sync for Ptrs {}
-    let ptrs = Ptrs(lhs, rhs, out);
-    let rows_per = bias_block_rows(n);
-    let blocks = m.div_ceil(rows_per);
-    let run = |blk: usize| {
-        let p = &ptrs;
-        let r0 = blk * rows_per;
-        let rows = rows_per.min(m - r0);
-        let dst = unsafe { p.2.add(r0 * n) };
-        let a = unsafe { p.0.offset(r0 as isize * lrs) };
-        unsafe {
-            gemm_call(
-                rows,
-                n,
-                k,
-                dst,
-                1,
-                n as isize,
-                a,
-                lcs,
-                lrs,
-                p.1,
-                rcs,
-                rrs,
-                gemm::Parallelism::None,
-            )
-        };
-        let block = unsafe { core::slice::from_raw_parts_mut(dst, rows * n) };
-        for row in block.chunks_exact_mut(n) {
-            for (x, b) in row.iter_mut().zip(bias) {
-                *x += b;
-            }
-        }
-    };
-    #[cfg(feature = "rayon")]
-    if m.saturating_mul(n).saturating_mul(k) >= PARALLEL_THRESHOLD && blocks > 1 {
-        use rayon::prelude::*;
-        (0..blocks).into_par_iter().for_each(run);
-        return;
-    }
-    (0..blocks).for_each(run);
-}
-
-/// A contiguous m x n output tensor filled by `write`, allocated without zeroing when its size
-/// is a whole number of 16-byte words (patch, see vendor/README.md: zeroing a [32768, 128]
-/// output is a 16 MB memset per product, measured at 2.6 % of a training step).
-///
-/// # Safety
-/// `write` must write every one of the m n elements it is given.
-unsafe fn output_written_by<T: Element + bytemuck::Pod>(
-    m: usize,
-    n: usize,
-    write: impl FnOnce(*mut T),
-) -> FlexTensor {
-    let bytes = m * n * core::mem::size_of::<T>();
-    let word = core::mem::size_of::<u128>();
-    if bytes % word != 0 {
-        let mut output = FlexTensor::empty(Shape::from(vec![m, n]), T::dtype());
-        write(output.storage_mut::<T>().as_mut_ptr());
-        return output;
-    }
-    let mut buf: Vec<u128> = Vec::with_capacity(bytes / word);
-    write(buf.as_mut_ptr() as *mut T);
-    // SAFETY: the caller's contract: every byte of the buffer was written.
-    unsafe { buf.set_len(bytes / word) };
-    FlexTensor::new(Bytes::from_elems(buf), Layout::contiguous(Shape::from(vec![m, n])), T::dtype())
 }
 
 /// Extract 2D matrix strides from a tensor layout.
@@ -468,28 +260,31 @@ fn matmul_2d_strided<T: GemmScalar>(lhs: FlexTensor, rhs: FlexTensor) -> FlexTen
     let lhs_ptr = unsafe { lhs_data.as_ptr().add(lhs.layout().start_offset()) };
     let rhs_ptr = unsafe { rhs_data.as_ptr().add(rhs.layout().start_offset()) };
 
+    let out_shape = Shape::from(vec![m, n]);
+    let mut output = FlexTensor::empty(out_shape, T::dtype());
+    let out_data: &mut [T] = output.storage_mut();
+
     let parallelism = get_parallelism(m, n, k);
 
-    // SAFETY: gemm with `read_dst = false` writes every element of dst and reads none.
     unsafe {
-        output_written_by::<T>(m, n, |out| {
-            gemm_call(
-                m,
-                n,
-                k,
-                out,
-                1,
-                n as isize,
-                lhs_ptr,
-                lhs_col_stride,
-                lhs_row_stride,
-                rhs_ptr,
-                rhs_col_stride,
-                rhs_row_stride,
-                parallelism,
-            )
-        })
+        gemm_call(
+            m,
+            n,
+            k,
+            out_data.as_mut_ptr(),
+            1,
+            n as isize,
+            lhs_ptr,
+            lhs_col_stride,
+            lhs_row_stride,
+            rhs_ptr,
+            rhs_col_stride,
+            rhs_row_stride,
+            parallelism,
+        );
     }
+
+    output
 }
 
 /// Strided gemm call for one matrix. Wraps `gemm::gemm` with GemmScalar zero/one.

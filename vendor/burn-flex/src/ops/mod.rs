@@ -109,14 +109,8 @@ pub mod gather_scatter;
 pub mod grid_sample;
 mod int;
 pub mod interpolate;
-pub mod linear;
 pub mod mask;
 pub mod matmul;
-#[cfg(all(feature = "std", target_arch = "x86_64", target_os = "linux"))]
-pub mod matmul_amx;
-#[cfg(feature = "std")]
-pub mod matmul_bf16dot;
-pub mod matmul_split_k;
 mod module;
 pub mod pool;
 mod qtensor;

@@ -731,14 +731,6 @@ impl ModuleOps<Flex> for Flex {
         crate::ops::attention::attention(query, key, value, mask, attn_bias, options)
     }
 
-    fn linear(
-        x: FloatTensor<Flex>,
-        weight: FloatTensor<Flex>,
-        bias: Option<FloatTensor<Flex>>,
-    ) -> FloatTensor<Flex> {
-        crate::ops::linear::linear(x, weight, bias)
-    }
-
     fn embedding(weights: FloatTensor<Flex>, indices: IntTensor<Flex>) -> FloatTensor<Flex> {
         let [batch_size, seq_length] = indices.shape().dims();
         let [_, d_model] = weights.shape().dims();

@@ -1,4 +1,4 @@
-//! f32 matrix products through bf16 dot products (patch; see vendor/README.md).
+//! f32 matrix products through bf16 dot products.
 //!
 //! The CPU counterpart of PyTorch's `torch.set_float32_matmul_precision("medium")`: both
 //! operands of an f32 product are rounded to bfloat16 (round to nearest even), pairs of products
@@ -7,9 +7,8 @@
 //! same numbers come from rounding the operands and calling the f32 gemm (slower than plain f32,
 //! but the same precision, so a fit does not change its meaning with the machine).
 //!
-//! The precision is chosen per calling thread with [`set_f32_matmul_precision`] (default
-//! [`MatmulPrecision::Highest`], plain f32): a training loop can opt in while an evaluation on
-//! another thread keeps f32.
+//! The caller chooses the precision per product ([`crate::Precision`], an argument of
+//! [`crate::matmul`]); nothing here is global but the AMX switch for tests.
 //!
 //! The kernel computes a 12 x 32 tile of the output in 24 zmm accumulators over the whole inner
 //! dimension. The left operand is read as bf16 pairs (two consecutive k of one row, one u32),
@@ -19,31 +18,6 @@
 
 use alloc::vec;
 use alloc::vec::Vec;
-use core::cell::Cell;
-
-/// The precision of f32 matrix products on the calling thread.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum MatmulPrecision {
-    /// Plain f32 products and sums (the default).
-    #[default]
-    Highest,
-    /// Operands rounded to bf16, products summed in f32 (`vdpbf16ps` where the CPU has it).
-    Bf16,
-}
-
-std::thread_local! {
-    static PRECISION: Cell<MatmulPrecision> = const { Cell::new(MatmulPrecision::Highest) };
-}
-
-/// Sets the precision of f32 matrix products issued from this thread; returns the previous one.
-pub fn set_f32_matmul_precision(precision: MatmulPrecision) -> MatmulPrecision {
-    PRECISION.with(|p| p.replace(precision))
-}
-
-/// The precision of f32 matrix products issued from this thread.
-pub fn f32_matmul_precision() -> MatmulPrecision {
-    PRECISION.with(|p| p.get())
-}
 
 /// Whether this CPU runs bf16 products natively (AVX512-BF16); otherwise they are emulated.
 pub fn bf16_dot_native() -> bool {
@@ -59,12 +33,12 @@ pub fn bf16_dot_native() -> bool {
     }
 }
 
-/// Whether the bf16 products run on Intel's AMX tiles (patch 7, `matmul_amx`): the CPU has
-/// AMX-TILE and AMX-BF16, Linux granted the tile registers, and `BURN_FLEX_AMX=0` is not set.
+/// Whether the bf16 products run on Intel's AMX tiles ([`crate::amx`]): the CPU has
+/// AMX-TILE and AMX-BF16, Linux granted the tile registers, and `CPU_KERNELS_AMX=0` is not set.
 pub fn bf16_amx_active() -> bool {
     #[cfg(all(target_arch = "x86_64", target_os = "linux"))]
     {
-        super::matmul_amx::amx_active()
+        crate::amx::amx_active()
     }
     #[cfg(not(all(target_arch = "x86_64", target_os = "linux")))]
     {
@@ -77,7 +51,7 @@ pub fn bf16_amx_active() -> bool {
 /// compare the two kernels on one machine.
 pub fn set_bf16_amx_enabled(enabled: bool) {
     #[cfg(all(target_arch = "x86_64", target_os = "linux"))]
-    super::matmul_amx::set_amx_enabled(enabled);
+    crate::amx::set_amx_enabled(enabled);
     #[cfg(not(all(target_arch = "x86_64", target_os = "linux")))]
     let _ = enabled;
 }
@@ -101,9 +75,12 @@ pub fn round_to_bf16(x: f32) -> f32 {
 
 /// Strided view of a row-major-or-not f32 matrix: element (i, j) at `ptr + i*rs + j*cs`.
 #[derive(Clone, Copy)]
-pub(crate) struct MatRef {
+pub struct MatRef {
+    /// Element (0, 0).
     pub ptr: *const f32,
+    /// Elements from one row to the next.
     pub rs: isize,
+    /// Elements from one column to the next.
     pub cs: isize,
 }
 
@@ -137,7 +114,7 @@ impl MatRef {
 /// # Safety
 /// `lhs` and `rhs` must address valid m x k and k x n matrices, `out` m * n writable floats;
 /// `bias`, if any, holds n values.
-pub(crate) unsafe fn matmul_bf16dot(
+pub unsafe fn matmul_bf16dot(
     m: usize,
     n: usize,
     k: usize,
@@ -153,8 +130,8 @@ pub(crate) unsafe fn matmul_bf16dot(
         unsafe { core::ptr::write_bytes(out, 0, m * n) };
     } else {
         #[cfg(all(target_arch = "x86_64", target_os = "linux"))]
-        if super::matmul_amx::amx_active() {
-            unsafe { super::matmul_amx::matmul(m, n, k, lhs, rhs, out, bias) };
+        if crate::amx::amx_active() {
+            unsafe { crate::amx::matmul(m, n, k, lhs, rhs, out, bias) };
             return;
         }
         #[cfg(target_arch = "x86_64")]

@@ -1,5 +1,4 @@
-//! f32 products with a long inner dimension and a small output, split over k (patch 4, see
-//! the workspace's `vendor/README.md`).
+//! f32 products with a long inner dimension and a small output, split over k.
 //!
 //! A training step's weight gradients are `Xᵀ dY`: [d_in, batch] x [batch, d_out], an output
 //! of at most a few hundred squared summed over tens of thousands of samples. The gemm crate
@@ -25,7 +24,7 @@ const MAX_OUTPUT: usize = 256 * 256;
 
 /// How many blocks of k an m x k by k x n product is split into: 1 (not split) unless k is at
 /// least two blocks long and the output is small.
-pub(crate) fn split_k_blocks(m: usize, n: usize, k: usize) -> usize {
+pub fn split_k_blocks(m: usize, n: usize, k: usize) -> usize {
     if k < 2 * BLOCK_K || m.saturating_mul(n) > MAX_OUTPUT || m == 0 || n == 0 {
         return 1;
     }

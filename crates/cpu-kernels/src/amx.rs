@@ -1,6 +1,6 @@
-//! bf16 dot products on Intel's AMX tiles (patch 7; see vendor/README.md).
+//! bf16 dot products on Intel's AMX tiles.
 //!
-//! The same product as [`super::matmul_bf16dot`] (operands rounded to bf16 with round to
+//! The same product as [`crate::bf16dot`] (operands rounded to bf16 with round to
 //! nearest even, products summed in f32, f32 output) on the tile unit of Xeons from Sapphire
 //! Rapids on: one `tdpbf16ps` multiplies a 16 x 32 bf16 tile by a 32 x 16 one into a 16 x 16
 //! f32 tile, 8,192 multiply-adds, where an AVX-512 `vdpbf16ps` does 32. On such a Xeon the
@@ -18,13 +18,13 @@
 //!
 //! Linux gives a process the tile registers only on request (`arch_prctl(ARCH_REQ_XCOMP_PERM,
 //! XFEATURE_XTILEDATA)`); [`amx_active`] asks once and answers false when the CPU lacks AMX-TILE
-//! or AMX-BF16, when the request fails, or when `BURN_FLEX_AMX=0` is set (to measure the
+//! or AMX-BF16, when the request fails, or when `CPU_KERNELS_AMX=0` is set (to measure the
 //! AVX-512 kernel on the same machine; [`set_amx_enabled`] does the same from code). Every
 //! task configures the tiles on its own thread and releases them when it is done.
 
-use super::matmul_bf16dot::MatRef;
-use super::matmul_bf16dot::pair_bits;
-use super::matmul_bf16dot::x86::{PAIR_ORDER, SendPtr, convert_row, pack_b_pair};
+use crate::bf16dot::MatRef;
+use crate::bf16dot::pair_bits;
+use crate::bf16dot::x86::{PAIR_ORDER, SendPtr, convert_row, pack_b_pair};
 use alloc::vec;
 use alloc::vec::Vec;
 use core::arch::asm;
@@ -55,10 +55,10 @@ pub fn set_amx_enabled(enabled: bool) {
 }
 
 fn detect() -> bool {
-    if std::env::var("BURN_FLEX_AMX").is_ok_and(|v| v.trim() == "0") {
+    if std::env::var("CPU_KERNELS_AMX").is_ok_and(|v| v.trim() == "0") {
         return false;
     }
-    if !super::matmul_bf16dot::bf16_dot_native() || __cpuid(0).eax < 7 {
+    if !crate::bf16dot::bf16_dot_native() || __cpuid(0).eax < 7 {
         return false;
     }
     let edx = __cpuid_count(7, 0).edx;
@@ -196,11 +196,11 @@ unsafe fn block(
 }
 
 /// out (m x n, row-major) = lhs (m x k) * rhs (k x n) [+ bias, one value per column] with bf16
-/// operands on AMX tiles. The bias is added to each 32 x 32 block as it leaves the tiles (patch
-/// 8), the same f32 addition as a separate pass.
+/// operands on AMX tiles. The bias is added to each 32 x 32 block as it leaves the tiles
+/// (fused linear layers), the same f32 addition as a separate pass.
 ///
 /// # Safety
-/// As [`super::matmul_bf16dot::matmul_bf16dot`]; [`amx_active`] must be true; m, n, k > 0;
+/// As [`crate::bf16dot::matmul_bf16dot`]; [`amx_active`] must be true; m, n, k > 0;
 /// `bias`, if any, holds n values.
 pub(crate) unsafe fn matmul(
     m: usize,
@@ -215,7 +215,7 @@ pub(crate) unsafe fn matmul(
     if k >= 2048 && m * n <= k * 16 {
         unsafe { split_k(m, n, k, lhs, rhs, out) };
         if let Some(b) = bias {
-            unsafe { super::matmul_bf16dot::add_bias_rows(m, n, out, b) };
+            unsafe { crate::bf16dot::add_bias_rows(m, n, out, b) };
         }
         return;
     }
@@ -391,6 +391,7 @@ unsafe fn pack_b(n: usize, k: usize, kpp: usize, rhs: MatRef) -> Vec<u32> {
 /// pair p of row i0 + r at `dst + r * stride + (p - p0)`. Row-contiguous operands are
 /// converted row by row, column-contiguous ones (a transposed activation, the weight
 /// gradient's left operand) 16 x 16 pairs at a time through a register transpose.
+#[allow(clippy::too_many_arguments)]
 pub(crate) unsafe fn pack_a(
     lhs: MatRef,
     i0: usize,
@@ -453,7 +454,7 @@ unsafe fn transpose_pairs(lhs: MatRef, i: usize, p: usize, dst: *mut u32, stride
             let s0 = lhs.at_ptr(i, 2 * (p + q));
             let s1 = s0.offset(lhs.cs);
             let xy = _mm512_cvtne2ps_pbh(_mm512_loadu_ps(s1), _mm512_loadu_ps(s0));
-            *vq = _mm512_permutexvar_epi16(interleave, core::mem::transmute::<_, __m512i>(xy));
+            *vq = _mm512_permutexvar_epi16(interleave, core::mem::transmute::<__m512bh, __m512i>(xy));
         }
         let t = transpose16(v);
         for (r, tr) in t.iter().enumerate() {

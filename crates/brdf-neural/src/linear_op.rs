@@ -1,0 +1,39 @@
+//! The models' linear layers, `y = x W + b`, as a burn backend extension ([`LinearKernels`]):
+//! on the flex CPU backend the three products of a layer (forward, input gradient, weight
+//! gradient) run on this workspace's kernels (`cpu-kernels`, through [`crate::flex_linear`]);
+//! on every other backend [`linear`] is burn's own `linear`.
+//!
+//! burn's extension mechanism (`#[backend_extension]`) routes the operation through burn's
+//! dispatch layer to the backend that holds the tensors, so burn itself stays unpatched. Its
+//! autodiff half is written here: [`LinearKernels`] for `Autodiff<B>` records one graph node per
+//! layer whose backward pass calls the backend's input-gradient and weight-gradient kernels and
+//! burn's bias gradient, the same three gradients as burn's own `linear`.
+//!
+//! The precision of the products ([`MatmulPrecision`]) is an argument of the operation, kept in
+//! the graph node for the backward pass: a bf16 training step computes its forward and backward
+//! products in bf16, and nothing else in the process changes precision.
+
+use crate::precision::MatmulPrecision;
+use burn::tensor::Tensor;
+#[cfg(feature = "flex")]
+pub use kernels::LinearKernels;
+
+/// `x W + b` for x `[rows, d_in]`, W `[d_in, d_out]`, b `[d_out]`, its products in `precision`
+/// on the flex backend (f32 elsewhere: [`MatmulPrecision::scope`] refuses bf16 on other
+/// backends); burn's `linear` on every other backend.
+pub fn linear(
+    x: Tensor<2>,
+    weight: Tensor<2>,
+    bias: Option<Tensor<1>>,
+    precision: MatmulPrecision,
+) -> Tensor<2> {
+    #[cfg(feature = "flex")]
+    if x.device().inner() == burn::tensor::Device::flex() {
+        return kernels::linear(x, weight, bias, precision);
+    }
+    let _ = precision;
+    burn::tensor::module::linear(x, weight, bias)
+}
+
+#[cfg(feature = "flex")]
+mod kernels;

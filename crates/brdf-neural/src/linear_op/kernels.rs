@@ -1,0 +1,246 @@
+//! The extension trait [`LinearKernels`], its flex implementation (the `cpu-kernels` crate
+//! through [`crate::flex_linear`]) and its autodiff implementation (one graph node per layer).
+
+use crate::precision::MatmulPrecision;
+use burn::backend::autodiff::NodeId;
+use burn::backend::autodiff::checkpoint::base::Checkpointer;
+use burn::backend::autodiff::checkpoint::strategy::CheckpointStrategy;
+use burn::backend::autodiff::grads::Gradients;
+use burn::backend::autodiff::ops::{Backward, Ops, OpsKind};
+use burn::backend::tensor::FloatTensor;
+use burn::backend::{Autodiff, Backend, Dispatch, Flex, backend_extension};
+use burn::tensor::Tensor;
+
+/// The kernels' spelling of a precision.
+fn kernel_precision(p: MatmulPrecision) -> cpu_kernels::Precision {
+    match p {
+        MatmulPrecision::F32 => cpu_kernels::Precision::F32,
+        MatmulPrecision::Bf16 => cpu_kernels::Precision::Bf16,
+    }
+}
+
+/// A linear layer's forward and gradient products, for backends with kernels of their own.
+/// (burn 0.22.1's extension macro does not route an `Option` of a tensor, hence a separate
+/// operation for layers without bias.)
+#[backend_extension(Flex, Autodiff)]
+pub trait LinearKernels: Backend {
+    /// `x W + b` for x `[rows, d_in]`, W `[d_in, d_out]`, b `[d_out]`.
+    fn kernel_linear(
+        x: FloatTensor<Self>,
+        weight: FloatTensor<Self>,
+        bias: FloatTensor<Self>,
+        precision: MatmulPrecision,
+    ) -> FloatTensor<Self>;
+
+    /// `x W`, a layer without bias.
+    fn kernel_linear_no_bias(
+        x: FloatTensor<Self>,
+        weight: FloatTensor<Self>,
+        precision: MatmulPrecision,
+    ) -> FloatTensor<Self>;
+
+    /// The input gradient `dY Wᵀ`.
+    fn kernel_linear_x_backward(
+        weight: FloatTensor<Self>,
+        output_grad: FloatTensor<Self>,
+        precision: MatmulPrecision,
+    ) -> FloatTensor<Self>;
+
+    /// The weight gradient `Xᵀ dY`.
+    fn kernel_linear_weight_backward(
+        x: FloatTensor<Self>,
+        output_grad: FloatTensor<Self>,
+        precision: MatmulPrecision,
+    ) -> FloatTensor<Self>;
+}
+
+impl LinearKernels for Flex {
+    fn kernel_linear(
+        x: FloatTensor<Self>,
+        weight: FloatTensor<Self>,
+        bias: FloatTensor<Self>,
+        precision: MatmulPrecision,
+    ) -> FloatTensor<Self> {
+        crate::flex_linear::linear(x, weight, Some(bias), kernel_precision(precision))
+    }
+
+    fn kernel_linear_no_bias(
+        x: FloatTensor<Self>,
+        weight: FloatTensor<Self>,
+        precision: MatmulPrecision,
+    ) -> FloatTensor<Self> {
+        crate::flex_linear::linear(x, weight, None, kernel_precision(precision))
+    }
+
+    fn kernel_linear_x_backward(
+        weight: FloatTensor<Self>,
+        output_grad: FloatTensor<Self>,
+        precision: MatmulPrecision,
+    ) -> FloatTensor<Self> {
+        crate::flex_linear::linear_x_backward(weight, output_grad, kernel_precision(precision))
+    }
+
+    fn kernel_linear_weight_backward(
+        x: FloatTensor<Self>,
+        output_grad: FloatTensor<Self>,
+        precision: MatmulPrecision,
+    ) -> FloatTensor<Self> {
+        crate::flex_linear::linear_weight_backward(x, output_grad, kernel_precision(precision))
+    }
+}
+
+/// The backward pass of one linear layer with a bias ([`LinearBackward`]) or without
+/// ([`LinearNoBiasBackward`]): x and W are checkpointed only where the other one needs a
+/// gradient, as in burn's own `linear`.
+#[derive(Debug)]
+struct LinearBackward;
+/// See [`LinearBackward`].
+#[derive(Debug)]
+struct LinearNoBiasBackward;
+
+/// The checkpointed x and W of a layer, and the precision of its products.
+type LinearState = (Option<NodeId>, Option<NodeId>, MatmulPrecision);
+
+/// Registers the gradients of x and W (where their nodes are tracked) for `grad`.
+fn register_x_and_weight<B: LinearKernels>(
+    [node_x, node_weight]: [Option<NodeId>; 2],
+    (x_state, weight_state, precision): LinearState,
+    grad: &B::FloatTensorPrimitive,
+    grads: &mut Gradients,
+    checkpointer: &mut Checkpointer,
+) {
+    let x = x_state.map(|id| checkpointer.retrieve_node_output::<B::FloatTensorPrimitive>(id));
+    let weight =
+        weight_state.map(|id| checkpointer.retrieve_node_output::<B::FloatTensorPrimitive>(id));
+    if let (Some(id), Some(weight)) = (node_x, weight) {
+        grads.register::<B>(id, B::kernel_linear_x_backward(weight, grad.clone(), precision));
+    }
+    if let (Some(id), Some(x)) = (node_weight, x) {
+        grads.register::<B>(id, B::kernel_linear_weight_backward(x, grad.clone(), precision));
+    }
+}
+
+impl<B: LinearKernels> Backward<B, 3> for LinearBackward {
+    type State = LinearState;
+
+    fn backward(
+        self,
+        ops: Ops<Self::State, 3>,
+        grads: &mut Gradients,
+        checkpointer: &mut Checkpointer,
+    ) {
+        let [node_x, node_weight, node_bias] = ops.parents;
+        let grad = grads.consume::<B>(&ops.node);
+        let ids = [node_x.map(|n| n.id), node_weight.map(|n| n.id)];
+        register_x_and_weight::<B>(ids, ops.state, &grad, grads, checkpointer);
+        if let Some(node) = node_bias {
+            grads.register::<B>(node.id, B::linear_bias_backward(grad));
+        }
+    }
+}
+
+impl<B: LinearKernels> Backward<B, 2> for LinearNoBiasBackward {
+    type State = LinearState;
+
+    fn backward(
+        self,
+        ops: Ops<Self::State, 2>,
+        grads: &mut Gradients,
+        checkpointer: &mut Checkpointer,
+    ) {
+        let grad = grads.consume::<B>(&ops.node);
+        let ids = ops.parents.map(|n| n.map(|n| n.id));
+        register_x_and_weight::<B>(ids, ops.state, &grad, grads, checkpointer);
+    }
+}
+
+impl<B: LinearKernels, C: CheckpointStrategy> LinearKernels for Autodiff<B, C> {
+    fn kernel_linear(
+        x: FloatTensor<Self>,
+        weight: FloatTensor<Self>,
+        bias: FloatTensor<Self>,
+        precision: MatmulPrecision,
+    ) -> FloatTensor<Self> {
+        let (x_tracked, weight_tracked) = (x.is_tracked(), weight.is_tracked());
+        match LinearBackward
+            .prepare::<C>([x.node(), weight.node(), bias.node()])
+            .compute_bound()
+            .stateful()
+        {
+            OpsKind::Tracked(mut prep) => {
+                // x is needed only for the weight gradient, W only for the input gradient.
+                let x_state = weight_tracked.then(|| prep.checkpoint(&x));
+                let weight_state = x_tracked.then(|| prep.checkpoint(&weight));
+                let (x, w, b) =
+                    (x.into_primitive(), weight.into_primitive(), bias.into_primitive());
+                prep.finish(
+                    (x_state, weight_state, precision),
+                    B::kernel_linear(x, w, b, precision),
+                )
+            }
+            OpsKind::UnTracked(prep) => {
+                let (x, w, b) =
+                    (x.into_primitive(), weight.into_primitive(), bias.into_primitive());
+                prep.finish(B::kernel_linear(x, w, b, precision))
+            }
+        }
+    }
+
+    fn kernel_linear_no_bias(
+        x: FloatTensor<Self>,
+        weight: FloatTensor<Self>,
+        precision: MatmulPrecision,
+    ) -> FloatTensor<Self> {
+        let (x_tracked, weight_tracked) = (x.is_tracked(), weight.is_tracked());
+        match LinearNoBiasBackward
+            .prepare::<C>([x.node(), weight.node()])
+            .compute_bound()
+            .stateful()
+        {
+            OpsKind::Tracked(mut prep) => {
+                let x_state = weight_tracked.then(|| prep.checkpoint(&x));
+                let weight_state = x_tracked.then(|| prep.checkpoint(&weight));
+                let (x, w) = (x.into_primitive(), weight.into_primitive());
+                let y = B::kernel_linear_no_bias(x, w, precision);
+                prep.finish((x_state, weight_state, precision), y)
+            }
+            OpsKind::UnTracked(prep) => {
+                let (x, w) = (x.into_primitive(), weight.into_primitive());
+                prep.finish(B::kernel_linear_no_bias(x, w, precision))
+            }
+        }
+    }
+
+    fn kernel_linear_x_backward(
+        _weight: FloatTensor<Self>,
+        _output_grad: FloatTensor<Self>,
+        _precision: MatmulPrecision,
+    ) -> FloatTensor<Self> {
+        unreachable!("the input gradient is computed on the inner backend")
+    }
+
+    fn kernel_linear_weight_backward(
+        _x: FloatTensor<Self>,
+        _output_grad: FloatTensor<Self>,
+        _precision: MatmulPrecision,
+    ) -> FloatTensor<Self> {
+        unreachable!("the weight gradient is computed on the inner backend")
+    }
+}
+
+/// [`super::linear`] on a flex device, through the extension, which burn routes to
+/// `Autodiff<Flex>` or `Flex`.
+pub(super) fn linear(
+    x: Tensor<2>,
+    weight: Tensor<2>,
+    bias: Option<Tensor<1>>,
+    precision: MatmulPrecision,
+) -> Tensor<2> {
+    let (x, weight) = (x.into_dispatch(), weight.into_dispatch());
+    Tensor::from_dispatch(match bias {
+        Some(b) => {
+            <Dispatch as LinearKernels>::kernel_linear(x, weight, b.into_dispatch(), precision)
+        }
+        None => <Dispatch as LinearKernels>::kernel_linear_no_bias(x, weight, precision),
+    })
+}

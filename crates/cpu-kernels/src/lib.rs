@@ -1,0 +1,130 @@
+//! The CPU matrix-product kernels of the neural models' linear layers, on plain strided
+//! matrices (no tensor library): `brdf-neural` hands them burn-flex's buffers through a burn
+//! backend extension (`brdf_neural::linear_op`), so burn itself stays unpatched.
+//!
+//! One entry point, [`matmul`]: `out = lhs rhs (+ bias)` for f32 matrices with any strides,
+//! written into an m x n row-major buffer that may start uninitialised. It picks, in order:
+//!
+//! | path | when | module |
+//! | --- | --- | --- |
+//! | bf16 operands, f32 sums (AMX tiles, else `vdpbf16ps`, else emulated) | [`Precision::Bf16`], n >= 16, k >= 8, m n k >= 2^18 | [`bf16dot`], [`amx`] |
+//! | f32, k summed in blocks in parallel | a long k (>= 8,192) into a small output (<= 256 x 256): weight gradients | [`split_k`] |
+//! | f32 gemm in blocks of rows, bias added while the block is in cache | a bias, n >= 16 | [`gemm_f32`] |
+//! | f32 gemm (the `gemm` crate, as burn-flex calls it) | everything else | [`gemm_f32`] |
+//!
+//! A product's value depends on its operands, shape and precision only, never on the thread
+//! count: split-k's block count depends on k alone, and gemm parallelises over the output, not
+//! over k. A bias is added after the sum with one f32 addition per element, so `matmul` with a
+//! bias equals `matmul` without it followed by the broadcast add, to the bit.
+//!
+//! The precision is an argument of every call: nothing here is per thread or per process, but
+//! [`set_bf16_amx_enabled`], a switch for tests and benchmarks that compare the two bf16
+//! kernels on one machine (and `CPU_KERNELS_AMX=0`, which turns AMX off for a process).
+
+extern crate alloc;
+
+#[cfg(all(target_arch = "x86_64", target_os = "linux"))]
+pub mod amx;
+pub mod bf16dot;
+pub mod gemm_f32;
+pub mod split_k;
+
+pub use bf16dot::{
+    MatRef, bf16_amx_active, bf16_dot_native, emulated_row_major, round_to_bf16,
+    set_bf16_amx_enabled,
+};
+
+/// The precision of an f32 matrix product.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Precision {
+    /// f32 operands, f32 sums (the default).
+    #[default]
+    F32,
+    /// Operands rounded to bf16 (round to nearest even), products summed in f32: PyTorch's
+    /// `torch.set_float32_matmul_precision("medium")` on the CPU.
+    Bf16,
+}
+
+/// Whether an m x k by k x n product in [`Precision::Bf16`] takes the bf16 kernels: products
+/// that gain nothing (narrow outputs such as a 3-channel head, a short k, small products) stay
+/// f32.
+pub fn takes_bf16(m: usize, n: usize, k: usize) -> bool {
+    n >= 16 && k >= 8 && m.saturating_mul(n).saturating_mul(k) >= 1 << 18
+}
+
+/// `out = lhs rhs (+ bias)`: lhs m x k, rhs k x n (any strides), `out` m x n row-major,
+/// `bias` n values added to every row. Every element of `out` is written and none is read.
+///
+/// # Safety
+/// `lhs` and `rhs` address valid m x k and k x n f32 matrices with their strides, `out` m n
+/// writable floats that nothing else touches during the call; `bias`, if any, holds n values.
+#[allow(clippy::too_many_arguments)]
+pub unsafe fn matmul(
+    m: usize,
+    n: usize,
+    k: usize,
+    lhs: MatRef,
+    rhs: MatRef,
+    out: *mut f32,
+    bias: Option<&[f32]>,
+    precision: Precision,
+) {
+    if m == 0 || n == 0 {
+        return;
+    }
+    if let Some(b) = bias {
+        assert_eq!(b.len(), n, "cpu_kernels::matmul: bias of {} values for {n} columns", b.len());
+    }
+    if precision == Precision::Bf16 && takes_bf16(m, n, k) {
+        // SAFETY: the caller's contract, which is the kernel's.
+        unsafe { bf16dot::matmul_bf16dot(m, n, k, lhs, rhs, out, bias) };
+        return;
+    }
+    let blocks = split_k::split_k_blocks(m, n, k);
+    if blocks > 1 {
+        let op = |r: MatRef| split_k::Operand { ptr: r.ptr, rs: r.rs, cs: r.cs };
+        // SAFETY: the caller's contract, which is the kernel's.
+        unsafe { split_k::matmul_split_k(m, n, k, blocks, op(lhs), op(rhs), out) };
+        if let Some(b) = bias {
+            // SAFETY: `out` holds the m x n product just written.
+            unsafe { bf16dot::add_bias_rows(m, n, out, b) };
+        }
+        return;
+    }
+    match bias {
+        // SAFETY: the caller's contract, which is the kernel's.
+        Some(b) if n >= 16 && k > 0 => unsafe {
+            gemm_f32::gemm_bias_by_rows(m, n, k, lhs, rhs, b, out)
+        },
+        _ => {
+            // SAFETY: the caller's contract, which is the kernel's.
+            unsafe { gemm_f32::gemm(m, n, k, lhs, rhs, out) };
+            if let Some(b) = bias {
+                // SAFETY: `out` holds the m x n product just written.
+                unsafe { bf16dot::add_bias_rows(m, n, out, b) };
+            }
+        }
+    }
+}
+
+/// [`matmul`] on row-major slices into a new vector: `a` m x k, `b` k x n.
+///
+/// # Panics
+/// If the slice lengths do not match the shapes.
+pub fn matmul_row_major(
+    m: usize,
+    n: usize,
+    k: usize,
+    a: &[f32],
+    b: &[f32],
+    bias: Option<&[f32]>,
+    precision: Precision,
+) -> Vec<f32> {
+    assert!(a.len() == m * k && b.len() == k * n, "matmul_row_major: shapes");
+    let mut out = vec![0f32; m * n];
+    let lhs = MatRef { ptr: a.as_ptr(), rs: k as isize, cs: 1 };
+    let rhs = MatRef { ptr: b.as_ptr(), rs: n as isize, cs: 1 };
+    // SAFETY: the views address exactly the checked slices; `out` holds m n floats.
+    unsafe { matmul(m, n, k, lhs, rhs, out.as_mut_ptr(), bias, precision) };
+    out
+}
