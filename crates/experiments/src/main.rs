@@ -1,7 +1,8 @@
 //! The `experiments` command line: `fit` trains a model on a scene into a run directory, `eval`
 //! renders the test images of a finished run and computes its metrics, `export` writes a
-//! Disney or Torrance-Sparrow fit as glTF 2.0, Mitsuba 3 and pbrt-v4 files, `export-merl` any
-//! fit as a MERL binary.
+//! Disney or Torrance-Sparrow fit as glTF 2.0, Mitsuba 3 and pbrt-v4 files (a purely neural fit
+//! as a Mitsuba 3 scene for the Python package's `neural_brdf` plugin), `export-merl` any fit
+//! as a MERL binary.
 
 use anyhow::{Context, Result, bail};
 use brdf_neural::device::Backend;
@@ -90,6 +91,9 @@ enum Command {
     /// (`<out>/gltf`), a Mitsuba 3 scene (`<out>/mitsuba`) and a pbrt-v4 scene (`<out>/pbrt`),
     /// the last two with a scene file per test view and light; `<out>/export.json` reports the
     /// round trip (the test views re-rendered from the glTF file against the fit's renders).
+    /// A purely neural run (Single MLP, the additive models) exports to Mitsuba 3 only: the
+    /// scenes with a `neural_brdf` BSDF on the run's weights, rendered by the Python package's
+    /// plugin (`import neural_brdfs.mitsuba`).
     Export {
         /// Run directory.
         run: PathBuf,

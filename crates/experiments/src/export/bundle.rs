@@ -15,7 +15,9 @@ use super::material::{ExportedMaterial, MaterialKind};
 use super::round_trip::{RoundTrip, round_trip};
 use super::{gltf, mitsuba, pbrt, test_pairs};
 use crate::eval::FittedRun;
+use crate::run_dir::RunDir;
 use crate::{Error, Result};
+use brdf_neural::BrdfModel;
 use serde::Serialize;
 use std::path::Path;
 
@@ -69,7 +71,8 @@ impl Format {
 /// What [`export`] wrote (also `<out>/export.json`).
 #[derive(Clone, Debug, Serialize)]
 pub struct ExportSummary {
-    /// `disney` or `torrance_sparrow`.
+    /// `disney` or `torrance_sparrow` (a parametric fit's material), or the model kind of a
+    /// purely neural fit (`single_mlp`, ...).
     pub model: &'static str,
     /// Whether the fit is spatially uniform (one parameter row for the object).
     pub uniform: bool,
@@ -97,16 +100,13 @@ pub fn export(
 ) -> Result<ExportSummary> {
     let start = std::time::Instant::now();
     let fitted = FittedRun::open(run, scene, cache)?;
+    if !matches!(fitted.model, BrdfModel::Parametric(_)) {
+        return export_neural(run, out, formats, &fitted, start);
+    }
     let material = ExportedMaterial::from_run(&fitted)?;
-    let mesh = &fitted.dataset.mesh;
-    let positions: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.to_array()).collect();
-    let normals: Vec<[f32; 3]> = mesh
-        .vertex_normals(mesh_encoding::NormalWeighting::default())
-        .iter()
-        .map(|n| n.to_array())
-        .collect();
-    let export_mesh =
-        ExportMesh { positions: &positions, normals: &normals, triangles: &mesh.triangles };
+    let (positions, normals) = mesh_arrays(&fitted);
+    let triangles = &fitted.dataset.mesh.triangles;
+    let export_mesh = ExportMesh { positions: &positions, normals: &normals, triangles };
     let pairs = test_pairs(&fitted.dataset);
     let name = match material.kind {
         MaterialKind::Disney => "disney",
@@ -145,6 +145,81 @@ pub fn export(
             test_pairs: pairs.len(),
             files,
             round_trip: trip,
+            seconds: start.elapsed().as_secs_f64(),
+        };
+        let json =
+            serde_json::to_vec_pretty(&summary).map_err(|e| Error::format(out, e.to_string()))?;
+        stdx::fs::write_atomic(&tmp.join("export.json"), &json)?;
+        Ok(summary)
+    })
+}
+
+/// The mesh of `fitted`'s scene with its vertex normals, as the exporters take it.
+fn mesh_arrays(fitted: &FittedRun) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+    let mesh = &fitted.dataset.mesh;
+    let positions = mesh.positions.iter().map(|p| p.to_array()).collect();
+    let normals = mesh
+        .vertex_normals(mesh_encoding::NormalWeighting::default())
+        .iter()
+        .map(|n| n.to_array())
+        .collect();
+    (positions, normals)
+}
+
+/// A purely neural fit: the Mitsuba 3 scene with the `neural_brdf` BSDF of the Python package
+/// (`neural_brdfs.mitsuba`) and the run's portable weights beside it. glTF and pbrt-v4 have
+/// no neural material: asking for one of them alone is an error naming the alternatives;
+/// asking for all formats writes the Mitsuba scene only.
+fn export_neural(
+    run: &Path,
+    out: &Path,
+    formats: &[Format],
+    fitted: &FittedRun,
+    start: std::time::Instant,
+) -> Result<ExportSummary> {
+    let kind = fitted.config.model.kind.config_name();
+    if !formats.contains(&Format::Mitsuba) || formats.len() < Format::ALL.len() && formats.len() > 1
+    {
+        let asked: Vec<&str> = formats.iter().map(|f| f.dir()).collect();
+        return Err(Error::config(
+            "export.format",
+            format!(
+                "{kind} is a neural model: it exports to Mitsuba 3 only (`--format mitsuba`, \
+                 rendered by the `neural_brdf` plugin of the Python package), not to {}; \
+                 `experiments export-merl` writes a MERL table for other renderers",
+                asked.join(", ")
+            ),
+        ));
+    }
+    let (positions, normals) = mesh_arrays(fitted);
+    let mesh = ExportMesh {
+        positions: &positions,
+        normals: &normals,
+        triangles: &fitted.dataset.mesh.triangles,
+    };
+    let pairs = test_pairs(&fitted.dataset);
+    let dir_name = Format::Mitsuba.dir();
+    stdx::fs::write_dir_atomic(out, &[dir_name], |tmp| {
+        let dir = tmp.join(dir_name);
+        let weights = RunDir::new(run).weights();
+        let portable = RunDir::new(&dir);
+        super::portable::write(
+            &portable,
+            &weights,
+            &fitted.config,
+            &fitted.dataset,
+            &fitted.cache,
+        )?;
+        let mut written = mitsuba::write_scene(&dir, &mesh, &mitsuba::neural_bsdf(), &[], &pairs)?;
+        written.extend(["model.safetensors".to_string(), "model.json".to_string()]);
+        let summary = ExportSummary {
+            model: kind,
+            uniform: false,
+            vertices: positions.len(),
+            mean_parameters: serde_json::Map::new(),
+            test_pairs: pairs.len(),
+            files: written.into_iter().map(|w| format!("{dir_name}/{w}")).collect(),
+            round_trip: None,
             seconds: start.elapsed().as_secs_f64(),
         };
         let json =

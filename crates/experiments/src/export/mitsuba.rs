@@ -1,5 +1,6 @@
 //! A Mitsuba 3 scene of a fitted material: `object.xml` (the mesh, `mesh.ply`, with a
-//! `principled` BSDF) and one `view<v>_light<l>.xml` per test pair (perspective sensor, one
+//! `principled` BSDF for a parametric fit, or the Python package's `neural_brdf` plugin on the
+//! run's portable weights for a purely neural one, [`neural_bsdf`]) and one `view<v>_light<l>.xml` per test pair (perspective sensor, one
 //! directional emitter, direct illumination), named like the run's renders.
 //!
 //! Render one with `mitsuba view003_light002.xml` or from Python:
@@ -144,7 +145,30 @@ pub fn write(
     pairs: &[ExportPair],
 ) -> Result<Vec<String>> {
     let (bsdf, attrs) = principled(material);
-    ply::write(&dir.join("mesh.ply"), mesh, &attrs)?;
+    write_scene(dir, mesh, &bsdf, &attrs, pairs)
+}
+
+/// The BSDF element of a purely neural fit: the Python package's `neural_brdf` plugin
+/// (`neural_brdfs.mitsuba`, registered by importing it in a JIT variant such as
+/// `llvm_ad_rgb`) on the portable weights `model.json` / `model.safetensors` beside the
+/// scene. The plugin finds a surface point's spatial features from the mesh's triangle index
+/// and barycentrics, so `mesh.ply` keeps the scene's vertex and face order and has no UVs.
+pub fn neural_bsdf() -> String {
+    "    <bsdf type=\"neural_brdf\">\n        \
+     <string name=\"filename\" value=\"model.json\"/>\n    </bsdf>\n"
+        .to_string()
+}
+
+/// Writes `mesh.ply` (with `attrs`), `object.xml` (the mesh with `bsdf`) and one scene per
+/// test pair into `dir`; returns the file names.
+pub fn write_scene(
+    dir: &Path,
+    mesh: &ExportMesh<'_>,
+    bsdf: &str,
+    attrs: &[VertexAttribute<'_>],
+    pairs: &[ExportPair],
+) -> Result<Vec<String>> {
+    ply::write(&dir.join("mesh.ply"), mesh, attrs)?;
     let object = format!(
         "<scene version=\"3.0.0\">\n    <shape type=\"ply\" id=\"object\">\n        \
          <string name=\"filename\" value=\"mesh.ply\"/>\n{bsdf}    </shape>\n</scene>\n"

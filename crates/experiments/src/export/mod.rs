@@ -6,7 +6,9 @@
 //! renders. [`portable`] writes any fitted model's weights as safetensors with a JSON
 //! description, for PyTorch and numpy users.
 //!
-//! Purely neural fits leave as MERL tables only. The RGL tabulated format (Dupuy and Jakob
+//! Purely neural fits leave as MERL tables, and as Mitsuba 3 scenes whose `neural_brdf` BSDF
+//! (the Python package's plugin, `neural_brdfs.mitsuba`) evaluates the network itself
+//! ([`mitsuba::neural_bsdf`]). The RGL tabulated format (Dupuy and Jakob
 //! 2018) that Mitsuba 3's and pbrt-v4's `measured` BSDFs read is not written: its readers take
 //! spectral samples (`wavelengths`, `spectra`), while every fit here is RGB, so a file would
 //! need invented spectra (an RGB-to-spectrum upsampling the renderer then integrates back, not

@@ -10,6 +10,8 @@
   records as numpy arrays.
 * :class:`Run`: a fitted run, evaluated at surface points and directions, and exported (MERL
   tables; glTF, Mitsuba 3 and pbrt-v4 scenes).
+* :mod:`neural_brdfs.mitsuba` (optional, imported on its own; needs the ``mitsuba`` wheel): the
+  Mitsuba 3 BSDF plugin ``neural_brdf`` rendering a neural run's ``model.json`` weights.
 
 The conventions are those of the Rust crates (see ``docs/`` in the repository).
 """
