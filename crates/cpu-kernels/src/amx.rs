@@ -454,7 +454,8 @@ unsafe fn transpose_pairs(lhs: MatRef, i: usize, p: usize, dst: *mut u32, stride
             let s0 = lhs.at_ptr(i, 2 * (p + q));
             let s1 = s0.offset(lhs.cs);
             let xy = _mm512_cvtne2ps_pbh(_mm512_loadu_ps(s1), _mm512_loadu_ps(s0));
-            *vq = _mm512_permutexvar_epi16(interleave, core::mem::transmute::<__m512bh, __m512i>(xy));
+            *vq =
+                _mm512_permutexvar_epi16(interleave, core::mem::transmute::<__m512bh, __m512i>(xy));
         }
         let t = transpose16(v);
         for (r, tr) in t.iter().enumerate() {
