@@ -83,6 +83,7 @@ pub use fmbrdf::geometry::{body_features as fmbrdf_body_features, smith_tan as f
 pub use fmbrdf::quadrature::{
     NODES as FMBRDF_NORMALIZATION_NODES, TAIL as FMBRDF_NORMALIZATION_TAIL,
 };
+pub use fmbrdf::weights::file_bytes as fmbrdf_weights_file;
 pub use fmbrdf::{Fmbrdf, FmbrdfParams};
 pub use lambert::{Lambert, LambertParams};
 pub use params::ParamError;

@@ -446,7 +446,7 @@ fn lbo_features_are_interpolated_and_cached() {
 }
 
 #[test]
-fn parametric_fits_export_to_renderers() {
+fn fits_export_to_renderers() {
     use experiments::config::SpatialKind;
     use experiments::eval::FittedRun;
     use experiments::export::{ExportedMaterial, Format, export, gltf};
@@ -518,13 +518,23 @@ fn parametric_fits_export_to_renderers() {
     let back = gltf::read(&out.join("gltf/torrance_sparrow.gltf")).unwrap();
     assert_eq!(back, ExportedMaterial::from_run(&fitted).unwrap());
     assert!(!out.join("mitsuba").exists());
-    // A neural fit has no renderer material: the error says what to use, nothing is written.
+    // A neural fit has no glTF or pbrt-v4 material: asking for one is an error that says what
+    // to use, and nothing is written; all formats give the Mitsuba 3 scene for the Python
+    // package's `neural_brdf` plugin, with the portable weights beside it.
     let run = dir.0.join("neural");
     fit(&config("single_mlp", 20, ""), &run, FitOptions::default()).unwrap();
     let out = dir.0.join("neural-export");
-    let err = export(&run, &out, &Format::ALL, None, None).unwrap_err().to_string();
-    assert!(err.contains("export-merl"), "{err}");
+    let err = export(&run, &out, &[Format::Gltf], None, None).unwrap_err().to_string();
+    assert!(err.contains("export-merl") && err.contains("Mitsuba 3 only"), "{err}");
     assert!(!out.exists());
+    let e = export(&run, &out, &Format::ALL, None, None).unwrap();
+    assert_eq!(e.model, "single_mlp");
+    for f in ["object.xml", "mesh.ply", "model.json", "model.safetensors"] {
+        assert!(e.files.contains(&format!("mitsuba/{f}")), "{f}: {:?}", e.files);
+    }
+    let object = std::fs::read_to_string(out.join("mitsuba/object.xml")).unwrap();
+    assert!(object.contains("<bsdf type=\"neural_brdf\">"), "{object}");
+    assert!(!out.join("gltf").exists() && !out.join("pbrt").exists());
 }
 
 /// Runs the Khronos glTF validator on `path` when `NEURAL_BRDF_GLTF_VALIDATOR` names a folder

@@ -1,5 +1,7 @@
-"""Shared fixtures: a miniature sweep (one scene of the embedded spot mesh at 48 px, three
-models fitted 150 steps) made once per session by the workspace's xtask binary.
+"""Shared fixtures: a miniature sweep (one scene of the embedded spot mesh at 48 px, six
+models fitted 150 steps; rp, ts and fmbrdf for the Mitsuba plugin's parametric kinds, a few
+seconds)
+made once per session by the workspace's xtask binary.
 
 The binary is ``$NEURAL_BRDF_XTASK``, else ``target/debug/xtask`` of the workspace (built by
 ``cargo test --workspace`` or ``cargo build -p xtask``). Without it the tests that need a scene
@@ -16,7 +18,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[3]
 
 PROFILE = """\
 name = "python-tests"
-description = "the Python package's tests: one scene, three models, 150 steps"
+description = "the Python package's tests: one scene, six models, 150 steps"
 [data]
 meshes = ["embedded:spot"]
 materials = ["blue-acrylic"]
@@ -45,7 +47,7 @@ patience = 50
 energy_pairs = 4
 reciprocity_pairs = 200
 [sweep]
-models = ["disney", "single_mlp", "additive_shared_enhanced"]
+models = ["disney", "single_mlp", "additive_shared_enhanced", "rp", "ts", "fmbrdf"]
 """
 
 

@@ -32,5 +32,13 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene_dir::Scene>()?;
     m.add_class::<fitted::Run>()?;
     image_metrics::register(m)?;
+    m.add_function(wrap_pyfunction!(fmbrdf_weights_file, m)?)?;
     Ok(())
+}
+
+/// FMBRDF's helper-network weights as shipped in `brdf-analytic`
+/// (`assets/fmbrdf/fmbrdf_weights.bin`, MIT): for the Mitsuba plugin's FMBRDF kind.
+#[pyfunction]
+fn fmbrdf_weights_file(py: Python<'_>) -> Bound<'_, pyo3::types::PyBytes> {
+    pyo3::types::PyBytes::new(py, brdf_analytic::fmbrdf_weights_file())
 }

@@ -3,7 +3,7 @@
 pub(crate) mod geometry;
 mod network;
 pub(crate) mod quadrature;
-mod weights;
+pub(crate) mod weights;
 
 use crate::brdf::{Brdf, BrdfSample, Rgb};
 use crate::microfacet::{ALPHA_MIN, PairGeometry};

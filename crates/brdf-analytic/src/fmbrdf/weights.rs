@@ -10,6 +10,12 @@ use std::sync::OnceLock;
 /// The embedded weight file.
 static BYTES: &[u8] = include_bytes!("../../assets/fmbrdf/fmbrdf_weights.bin");
 
+/// The embedded weight file as shipped (`assets/fmbrdf/fmbrdf_weights.bin`), for tools outside
+/// Rust that evaluate the helper networks themselves (the Python package's Mitsuba plugin).
+pub fn file_bytes() -> &'static [u8] {
+    BYTES
+}
+
 /// Magic number at the start of the weight file.
 const MAGIC: &[u8; 8] = b"FMBRDFW1";
 

@@ -1,4 +1,5 @@
-"""A Mitsuba 3 BSDF plugin, ``neural_brdf``, for the purely neural fits of this workspace.
+"""A Mitsuba 3 BSDF plugin, ``neural_brdf``, for the neural and parametric fits of this
+workspace.
 
 >>> import mitsuba as mi
 >>> mi.set_variant("llvm_ad_rgb")            # or cuda_ad_rgb: a JIT variant with RGB colours
@@ -30,6 +31,9 @@ parameter          type      meaning
 ``precision``      string    the networks' matrix products: ``single`` (float32, the default on
                              LLVM) or ``half`` (float16: the only choice, and the default, on
                              CUDA, where Dr.Jit maps them to OptiX cooperative vectors)
+``fmbrdf_weights`` string    FMBRDF only: its helper networks' ``fmbrdf_weights.bin``; default
+                             ``$NEURAL_BRDF_FMBRDF_WEIGHTS``, else the package's own copy (the
+                             one ``brdf-analytic`` embeds)
 =================  ========  ================================================================
 
 Models: the neural kinds ``single_mlp``, ``additive_separate``, ``additive_shared`` and their
@@ -40,11 +44,18 @@ matrix) is one cooperative-vector ``drjit.nn.matvec``, float32 on LLVM (equal to
 to a few 1e-6 relative); CUDA's OptiX cooperative vectors multiply float16 only (median 4e-3,
 max 3e-2 relative; ``precision="half"`` reproduces it on LLVM). Unrolling the products into
 scalar FMAs instead takes LLVM 15 s to compile at width 64, growing quadratically. The
-parametric kinds (rp, ts, disney, fmbrdf) are refused with :class:`UnsupportedModelError` (a
-``ValueError``) naming the kind; a file that is not a ``neural-brdfs-weights`` description, or
-weights that do not fit it, with a ``ValueError`` naming the file and the fault (Mitsuba's loader
-re-raises both as ``RuntimeError`` with the message). Needs a libLLVM >= 16 for the LLVM
-variants (Mitsuba 3.9.1 itself aborts on ``llvm.maximum`` with LLVM 14/15).
+parametric kinds ``rp`` (Realistic Phong), ``ts`` (Torrance-Sparrow, GGX), ``disney`` and
+``fmbrdf`` (:mod:`neural_brdfs.mitsuba_parametric`): their parameter MLP (tensors ``mlp.*``)
+runs the same way, then the output nonlinearities and the analytic BRDF follow the Rust tensor
+twins operation for operation in float32 (rp, ts, disney equal ``Run.eval`` to about 1e-6
+relative, fmbrdf to about 1e-5: the Rust model evaluates its Lambda network by segments).
+FMBRDF also needs its two fixed helper networks (Smith Lambda, body reflection), which are not
+in ``model.safetensors``: the package ships them (``brdf-analytic``'s
+``assets/fmbrdf/fmbrdf_weights.bin``, MIT, through the native module), and ``fmbrdf_weights``
+points elsewhere; its kernels take LLVM several seconds each to compile. A file that is not a ``neural-brdfs-weights`` description, or
+weights that do not fit it, is refused with a ``ValueError`` naming the file and the fault
+(Mitsuba's loader re-raises both as ``RuntimeError`` with the message). Needs a libLLVM >= 16
+for the LLVM variants (Mitsuba 3.9.1 itself aborts on ``llvm.maximum`` with LLVM 14/15).
 
 Conventions (those of ``model.json``): the model's local frame is Duff et al. 2017's orthonormal
 basis around the shading normal, ``l`` towards the light, ``v`` towards the viewer, the output
@@ -81,24 +92,35 @@ import drjit as dr
 import mitsuba as mi
 import numpy as np
 
+from . import mitsuba_parametric as par
 from . import reference_numpy as ref
 from .mitsuba_sampling import fit_lobe
 
-__all__ = ["register", "load_model", "render_pixel_centres", "PLUGIN_NAME",
-           "UnsupportedModelError"]
+__all__ = ["register", "load_model", "render_pixel_centres", "mlp_specs", "PLUGIN_NAME",
+           "SUPPORTED_KINDS", "UnsupportedModelError"]
 
 PLUGIN_NAME = "neural_brdf"
+#: The model kinds the plugin renders: every neural kind and every parametric one (FMBRDF
+#: given its helper networks' weights, see :class:`DrJitModel`).
+SUPPORTED_KINDS = tuple(ref.NEURAL_KINDS) + par.SUPPORTED
+
+
+def mlp_specs(config):
+    """The networks of a supported kind by tensor prefix (neural or parametric)."""
+    if config.kind in ref.PARAMETRIC_KINDS:
+        return par.mlp_specs(config)
+    return ref.mlp_specs(config)
 
 
 class UnsupportedModelError(ValueError):
-    """A weights description of a kind the plugin does not render (the parametric kinds)."""
+    """A model the plugin cannot render: FMBRDF without its helper networks' weights."""
 
 
 # ---------------------------------------------------------------------------------- loading
 def load_model(filename, weights=None):
     """Reads and checks ``model.json`` and its weights: ``(config, spatial_kind, tensors,
     description)`` as :func:`neural_brdfs.reference_numpy.read_export`, with errors that name
-    the file and the fault (``ValueError``; ``UnsupportedModelError`` for parametric kinds)."""
+    the file and the fault (``ValueError``)."""
     filename = os.fspath(filename)
     try:
         with open(filename, encoding="utf-8") as fh:
@@ -116,12 +138,10 @@ def load_model(filename, weights=None):
         kind = ref.kind_name(model.get("kind", desc.get("kind", "single_mlp")))
     except ValueError as e:
         raise ValueError(f"{filename}: {e}") from None
-    if kind in ref.PARAMETRIC_KINDS:
+    if kind not in SUPPORTED_KINDS:
         raise UnsupportedModelError(
-            f"{filename}: model kind {kind!r} ({ref._PAPER_NAMES[kind]}) is a parametric model "
-            f"driven by an MLP, which the {PLUGIN_NAME} plugin does not render (supported: "
-            f"{', '.join(ref.NEURAL_KINDS)}); export parametric fits with "
-            f"`experiments export --format mitsuba` (principled BSDF) instead")
+            f"{filename}: model kind {kind!r} is not rendered by the {PLUGIN_NAME} plugin "
+            f"(supported: {', '.join(SUPPORTED_KINDS)})")
     output = str((desc.get("conventions") or {}).get("output", "linear RGB"))
     if "linear" not in output:
         raise ValueError(f"{filename}: output convention {output!r} is not linear RGB")
@@ -148,8 +168,9 @@ def load_model(filename, weights=None):
         msg = str(e) if str(e).startswith(weights) else f"{weights}: {e}"
         raise ValueError(f"not a valid safetensors file: {msg}") from None
     expected = {}
-    for prefix, spec in ref.mlp_specs(config).items():
+    for prefix, spec in mlp_specs(config).items():
         expected.update(spec.shapes(prefix))
+    expected.update(par.extra_tensors(config))
     got = {n: tuple(t.shape) for n, t in tensors.items() if not n.startswith("spatial.")}
     if got != expected:
         diff = sorted(set(got.items()) ^ set(expected.items()))[:8]
@@ -293,11 +314,24 @@ class _Mlp:
 class DrJitModel:
     """A neural BRDF in Dr.Jit: ``f(prim_index, b1, b2, l, v)`` -> ``mi.Color3f``."""
 
-    def __init__(self, config, spatial_kind, tensors, half=False):
+    def __init__(self, config, spatial_kind, tensors, half=False, fmbrdf_weights=None):
         self.config, self.spatial_kind, self.half = config, spatial_kind, half
-        self.nets = {p: _Mlp(s, tensors, p) for p, s in ref.mlp_specs(config).items()}
+        self.parametric = config.kind in ref.PARAMETRIC_KINDS
+        self.nets = {p: _Mlp(s, tensors, p) for p, s in mlp_specs(config).items()}
         for net in self.nets.values():
             net.pack(half)
+        self.fm = None
+        if config.kind == "fmbrdf":
+            path = fmbrdf_weights or par.default_fmbrdf_weights()
+            if not isinstance(path, bytes) and not os.path.exists(path):
+                raise UnsupportedModelError(
+                    f"model kind 'fmbrdf' (FMBRDF) needs the weights of FMBRDF's two fixed "
+                    f"helper networks (Smith Lambda, body reflection): {path} (the plugin's "
+                    f"'fmbrdf_weights' parameter or ${par.FMBRDF_WEIGHTS_ENV}) does not exist; "
+                    f"without either, the package's own copy is used")
+            alpha, beta, c = par.fmbrdf_globals(tensors["fm_alpha"], tensors["fm_beta"])
+            nets = par.FmbrdfNets(par.read_fmbrdf_weights(path), alpha, beta, half)
+            self.fm = (nets, alpha, beta, c)
         self.dim = config.spatial_dim
         if spatial_kind != "uniform":
             vf = np.asarray(tensors["spatial.vertex_features"], np.float32)
@@ -322,6 +356,8 @@ class DrJitModel:
 
     def forward(self, x, l, v):
         c = self.config
+        if self.parametric:
+            return par.forward(c, self.nets["mlp"](x), l, v, self.fm)
         ang = angle_features(c.angles, l, v)
         if c.kind == "single_mlp":
             z = self.nets["mlp"](x, ang)
@@ -379,7 +415,10 @@ def _bsdf_class():
                 raise ValueError(f"{PLUGIN_NAME}: precision must be 'single' or 'half' ('half' "
                                  f"on CUDA: OptiX multiplies float16 only), got "
                                  f"{self.precision!r}")
-            self.model = DrJitModel(config, skind, tensors, self.precision == "half")
+            fm_weights = props.get("fmbrdf_weights", None)
+            if fm_weights is not None:
+                fm_weights = str(fr.resolve(str(fm_weights)))
+            self.model = DrJitModel(config, skind, tensors, self.precision == "half", fm_weights)
             self.sampling = str(props.get("sampling", "lobe"))
             if self.sampling not in ("lobe", "cosine"):
                 raise ValueError(f"{PLUGIN_NAME}: sampling must be 'lobe' or 'cosine', got "
@@ -390,7 +429,10 @@ def _bsdf_class():
             if self.sampling == "cosine":
                 n, w = 1.0, 0.0
             elif n is None or w is None:
-                reference = ref._CLASSES[config.kind](config, tensors, skind, np.float32)
+                if self.model.parametric:
+                    reference = par.LobeFitModel(self.model, tensors, skind)
+                else:
+                    reference = ref._CLASSES[config.kind](config, tensors, skind, np.float32)
                 fn, fw, self.fit_info = fit_lobe(reference)
                 n = fn if n is None else n
                 w = fw if w is None else w
