@@ -130,7 +130,7 @@ enum Command {
         #[arg(long, default_value = "cpu", value_parser = parse_backend)]
         backend: Backend,
         /// Precision of the training steps' matrix products, for every run: `f32` or `bf16`
-        /// (CPU backend; about 1.5x faster fits on AVX512-BF16 CPUs, see README). Without it,
+        /// (CPU backend; about 1.5x faster fits on AVX512-BF16 CPUs, see docs/guide.md). Without it,
         /// the profile's `run.train.matmul_precision` holds (f32 unless it says otherwise).
         /// bf16 runs get their own run ids.
         #[arg(long, value_parser = parse_precision)]
