@@ -12,7 +12,7 @@ mitsuba.py) and prints every figure of its report, so they can be re-measured:
 5. render times against ours (``Run.eval`` on the pair's records plus the shading).
 
     target/py-venv/bin/python benches/mitsuba_plugin.py [--out DIR] [--xtask PATH] [--quick]
-        [--sections 1234] [--spp 16] [--ref-spp 2048]
+        [--sections 1234] [--spp 16] [--ref-spp 2048] [--material NAME]
 
 It trains a small sweep first (glossy MERL material, 3 models, ~1 min on 2 cores) with the
 xtask binary (``$NEURAL_BRDF_XTASK`` or target/debug/xtask) unless DIR already holds it.
@@ -37,7 +37,7 @@ name = "mitsuba-bench"
 description = "the Mitsuba plugin's measurements: one glossy scene, three models"
 [data]
 meshes = ["embedded:spot"]
-materials = ["specular-red-phenolic"]
+materials = ["{material}"]
 size = 64
 views = 4
 lights = 12
@@ -67,11 +67,11 @@ models = ["disney", "single_mlp", "additive_shared_enhanced"]
 """
 
 
-def sweep(out, xtask):
+def sweep(out, xtask, material="specular-red-phenolic"):
     if not list(pathlib.Path(out).glob("runs/*/model.json")):
         pathlib.Path(out).mkdir(parents=True, exist_ok=True)
         prof = pathlib.Path(out) / "profile.toml"
-        prof.write_text(PROFILE)
+        prof.write_text(PROFILE.replace("{material}", material))
         t = time.time()
         subprocess.run([xtask, "reproduce-tables", "--profile", str(prof), "--out", str(out),
                         "--jobs", "1"], check=True, stdout=subprocess.DEVNULL)
@@ -92,6 +92,8 @@ def main():
     ap.add_argument("--spp", type=int, default=16, help="spp of the RMSE comparison")
     ap.add_argument("--ref-spp", type=int, default=2048)
     ap.add_argument("--quick", action="store_true", help="fewer samples everywhere")
+    ap.add_argument("--material", default="specular-red-phenolic",
+                    help="the MERL-derived material of the bench sweep")
     ap.add_argument("--sections", default="1234", help="which of the sections 1-4 to run")
     a = ap.parse_args()
 
@@ -104,7 +106,7 @@ def main():
     from neural_brdfs import metrics
     from neural_brdfs import reference_numpy as ref
 
-    runs, scene_dir = sweep(a.out, a.xtask)
+    runs, scene_dir = sweep(a.out, a.xtask, a.material)
     work = pathlib.Path(a.out) / "mitsuba"
     shutil.rmtree(work, ignore_errors=True)
     nb.Run(runs["disney"]).export(work / "export", "mitsuba")

@@ -1,7 +1,7 @@
 //! The models' linear layers, `y = x W + b`, as a burn backend extension ([`LinearKernels`]):
 //! on the flex CPU backend the three products of a layer (forward, input gradient, weight
-//! gradient) run on this workspace's kernels (`cpu-kernels`, through [`crate::flex_linear`]);
-//! on every other backend [`linear`] is burn's own `linear`.
+//! gradient) run on this workspace's kernels (`cpu-kernels`, through the private module
+//! `flex_linear`); on every other backend [`linear`] is burn's own `linear`.
 //!
 //! burn's extension mechanism (`#[backend_extension]`) routes the operation through burn's
 //! dispatch layer to the backend that holds the tensors, so burn itself stays unpatched. Its
