@@ -117,3 +117,42 @@ pub(crate) fn linear_weight_backward(
     product(&x_t, &output_grad, None, precision)
         .unwrap_or_else(|| Flex::float_matmul(x_t, output_grad))
 }
+
+/// The bias gradient: `dY` summed over its rows (`cpu_kernels::elementwise::sum_rows`, on
+/// every thread); flex's own for anything but a contiguous f32 matrix.
+pub(crate) fn linear_bias_backward(output_grad: FlexTensor) -> FlexTensor {
+    let layout = output_grad.layout();
+    let shape = layout.shape();
+    if output_grad.dtype() == DType::F32
+        && shape.num_dims() == 2
+        && let Some((start, end)) = layout.contiguous_offsets()
+    {
+        let (rows, cols) = (shape[0], shape[1]);
+        let data: &[f32] = &output_grad.storage()[start..end];
+        let sums = cpu_kernels::elementwise::sum_rows(data, rows, cols);
+        return FlexTensor::new(
+            Bytes::from_elems(sums),
+            Layout::contiguous(Shape::new([cols])),
+            DType::F32,
+        );
+    }
+    <Flex as ModuleOps<Flex>>::linear_bias_backward(output_grad)
+}
+
+/// The ReLU gradient at `x`: `grad` masked in place where `x` is not positive (kept for NaN),
+/// on every thread, when `grad` is an f32 buffer of `x`'s layout that nothing else holds;
+/// flex's own `relu_backward` otherwise (the same values).
+pub(crate) fn relu_backward(x: FlexTensor, mut grad: FlexTensor) -> FlexTensor {
+    if x.dtype() == DType::F32
+        && grad.dtype() == DType::F32
+        && grad.layout().shape() == x.layout().shape()
+        && grad.is_unique()
+        && let (Some((0, g_end)), Some((x0, x1))) =
+            (grad.layout().contiguous_offsets(), x.layout().contiguous_offsets())
+    {
+        let xs: &[f32] = &x.storage()[x0..x1];
+        cpu_kernels::elementwise::relu_backward_in_place(&mut grad.storage_mut()[..g_end], xs);
+        return grad;
+    }
+    <Flex as burn::backend::ops::ActivationOps<Flex>>::relu_backward(x, grad)
+}

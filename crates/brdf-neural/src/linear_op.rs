@@ -35,5 +35,15 @@ pub fn linear(
     burn::tensor::module::linear(x, weight, bias)
 }
 
+/// `max(x, 0)`, its backward pass on this workspace's kernels on the flex backend (the mask
+/// applied in place to the upstream gradient, on every thread); burn's `relu` elsewhere.
+pub fn relu(x: Tensor<2>) -> Tensor<2> {
+    #[cfg(feature = "flex")]
+    if x.device().inner() == burn::tensor::Device::flex() {
+        return kernels::relu(x);
+    }
+    burn::tensor::activation::relu(x)
+}
+
 #[cfg(feature = "flex")]
 mod kernels;

@@ -22,10 +22,10 @@
 //! Every linear layer runs through [`crate::split_k`], which splits the batch sum of the
 //! weight gradients into parts on GPU backends.
 
+use crate::linear_op::relu;
 use crate::split_k::linear;
 use burn::module::Module;
 use burn::nn::{Linear, LinearConfig};
-use burn::tensor::activation::relu;
 use burn::tensor::{Device, Tensor};
 use serde::{Deserialize, Serialize};
 

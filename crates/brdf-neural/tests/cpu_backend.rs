@@ -130,18 +130,26 @@ fn long_products_split_over_k_match_f64_and_not_the_thread_count() {
 
 #[test]
 fn element_wise_ops_on_every_thread_equal_the_scalar_ops() {
-    // Large enough for vendor/burn-flex patch 5 (2^17 elements and more): ReLU and its
-    // backward, a bias add broadcast down the rows, and the bias gradient (a sum over rows).
+    // Large enough to run on every thread (2^17 elements and more): a linear layer's bias add,
+    // ReLU and its backward (`brdf_neural::linear_op::relu`, the mask in place), and the bias
+    // gradient (`cpu_kernels::elementwise::sum_rows`, blocks of rows). W is the identity, so
+    // the layer is z + b exactly.
+    use brdf_neural::linear_op;
+    use brdf_neural::precision::MatmulPrecision;
     let d = device::cpu_training();
     let (rows, cols) = (9_001, 37);
     let z = values(rows * cols, 11);
     let b = values(cols, 12);
     let g = values(rows * cols, 13);
+    let eye: Vec<f32> =
+        (0..cols * cols).map(|i| if i % (cols + 1) == 0 { 1.0 } else { 0.0 }).collect();
     let step = || {
         let tz = Tensor::<2>::from_data(TensorData::new(z.clone(), [rows, cols]), &d);
+        let tw = Tensor::<2>::from_data(TensorData::new(eye.clone(), [cols, cols]), &d);
         let tb = Tensor::<1>::from_data(TensorData::new(b.clone(), [cols]), &d).require_grad();
         let tg = Tensor::<2>::from_data(TensorData::new(g.clone(), [rows, cols]), &d);
-        let y = burn::tensor::activation::relu(tz + tb.clone().unsqueeze::<2>());
+        let layer = linear_op::linear(tz, tw, Some(tb.clone()), MatmulPrecision::F32);
+        let y = linear_op::relu(layer);
         let grads = (y.clone() * tg).sum().backward();
         let gb = tb.grad(&grads).unwrap().into_data().try_to_vec::<f32>().unwrap();
         (y.into_data().try_to_vec::<f32>().unwrap(), gb)
@@ -166,7 +174,7 @@ fn element_wise_ops_on_every_thread_equal_the_scalar_ops() {
 
 #[test]
 fn row_broadcasts_of_empty_and_thin_matrices_add_correctly() {
-    // The bias add of patch 5 takes dense [rows, cols] + [1, cols]; empty and one-wide shapes
+    // flex's bias add (vendor patch 5) takes dense [rows, cols] + [1, cols]; empty and one-wide shapes
     // must still add (the patch also guards its row loop against an empty row, which upstream's
     // layout collapse does not let reach it today).
     let d = device::cpu();

@@ -26,6 +26,7 @@ extern crate alloc;
 #[cfg(all(target_arch = "x86_64", target_os = "linux"))]
 pub mod amx;
 pub mod bf16dot;
+pub mod elementwise;
 pub mod gemm_f32;
 pub mod split_k;
 

@@ -7,6 +7,7 @@ use burn::backend::autodiff::checkpoint::base::Checkpointer;
 use burn::backend::autodiff::checkpoint::strategy::CheckpointStrategy;
 use burn::backend::autodiff::grads::Gradients;
 use burn::backend::autodiff::ops::{Backward, Ops, OpsKind};
+use burn::backend::ops::ActivationOps;
 use burn::backend::tensor::FloatTensor;
 use burn::backend::{Autodiff, Backend, Dispatch, Flex, backend_extension};
 use burn::tensor::Tensor;
@@ -52,6 +53,16 @@ pub trait LinearKernels: Backend {
         output_grad: FloatTensor<Self>,
         precision: MatmulPrecision,
     ) -> FloatTensor<Self>;
+
+    /// The bias gradient: `dY` `[rows, d_out]` summed over the rows.
+    fn kernel_linear_bias_backward(output_grad: FloatTensor<Self>) -> FloatTensor<Self>;
+
+    /// `max(x, 0)`.
+    fn kernel_relu(x: FloatTensor<Self>) -> FloatTensor<Self>;
+
+    /// The gradient of [`LinearKernels::kernel_relu`] at `x` for the upstream gradient `grad`:
+    /// `grad` where `x > 0` (or NaN), 0 elsewhere.
+    fn kernel_relu_backward(x: FloatTensor<Self>, grad: FloatTensor<Self>) -> FloatTensor<Self>;
 }
 
 impl LinearKernels for Flex {
@@ -86,6 +97,18 @@ impl LinearKernels for Flex {
         precision: MatmulPrecision,
     ) -> FloatTensor<Self> {
         crate::flex_linear::linear_weight_backward(x, output_grad, kernel_precision(precision))
+    }
+
+    fn kernel_linear_bias_backward(output_grad: FloatTensor<Self>) -> FloatTensor<Self> {
+        crate::flex_linear::linear_bias_backward(output_grad)
+    }
+
+    fn kernel_relu(x: FloatTensor<Self>) -> FloatTensor<Self> {
+        <Flex as ActivationOps<Flex>>::relu(x)
+    }
+
+    fn kernel_relu_backward(x: FloatTensor<Self>, grad: FloatTensor<Self>) -> FloatTensor<Self> {
+        crate::flex_linear::relu_backward(x, grad)
     }
 }
 
@@ -134,7 +157,7 @@ impl<B: LinearKernels> Backward<B, 3> for LinearBackward {
         let ids = [node_x.map(|n| n.id), node_weight.map(|n| n.id)];
         register_x_and_weight::<B>(ids, ops.state, &grad, grads, checkpointer);
         if let Some(node) = node_bias {
-            grads.register::<B>(node.id, B::linear_bias_backward(grad));
+            grads.register::<B>(node.id, B::kernel_linear_bias_backward(grad));
         }
     }
 }
@@ -151,6 +174,29 @@ impl<B: LinearKernels> Backward<B, 2> for LinearNoBiasBackward {
         let grad = grads.consume::<B>(&ops.node);
         let ids = ops.parents.map(|n| n.map(|n| n.id));
         register_x_and_weight::<B>(ids, ops.state, &grad, grads, checkpointer);
+    }
+}
+
+/// The backward pass of [`LinearKernels::kernel_relu`]: the upstream gradient masked where the
+/// input was not positive.
+#[derive(Debug)]
+struct ReluBackward;
+
+impl<B: LinearKernels> Backward<B, 1> for ReluBackward {
+    type State = NodeId;
+
+    fn backward(
+        self,
+        ops: Ops<Self::State, 1>,
+        grads: &mut Gradients,
+        checkpointer: &mut Checkpointer,
+    ) {
+        let x = checkpointer.retrieve_node_output::<B::FloatTensorPrimitive>(ops.state);
+        let [parent] = ops.parents;
+        let grad = grads.consume::<B>(&ops.node);
+        if let Some(node) = parent {
+            grads.register::<B>(node.id, B::kernel_relu_backward(x, grad));
+        }
     }
 }
 
@@ -211,6 +257,25 @@ impl<B: LinearKernels, C: CheckpointStrategy> LinearKernels for Autodiff<B, C> {
         }
     }
 
+    fn kernel_relu(x: FloatTensor<Self>) -> FloatTensor<Self> {
+        // As burn's own relu: the input is kept for the backward pass.
+        match ReluBackward.prepare::<C>([x.node()]).compute_bound().stateful() {
+            OpsKind::Tracked(mut prep) => {
+                let state = prep.checkpoint(&x);
+                prep.finish(state, B::kernel_relu(x.into_primitive()))
+            }
+            OpsKind::UnTracked(prep) => prep.finish(B::kernel_relu(x.into_primitive())),
+        }
+    }
+
+    fn kernel_relu_backward(_x: FloatTensor<Self>, _grad: FloatTensor<Self>) -> FloatTensor<Self> {
+        unreachable!("the ReLU gradient is computed on the inner backend")
+    }
+
+    fn kernel_linear_bias_backward(_output_grad: FloatTensor<Self>) -> FloatTensor<Self> {
+        unreachable!("the bias gradient is computed on the inner backend")
+    }
+
     fn kernel_linear_x_backward(
         _weight: FloatTensor<Self>,
         _output_grad: FloatTensor<Self>,
@@ -226,6 +291,11 @@ impl<B: LinearKernels, C: CheckpointStrategy> LinearKernels for Autodiff<B, C> {
     ) -> FloatTensor<Self> {
         unreachable!("the weight gradient is computed on the inner backend")
     }
+}
+
+/// [`super::relu`] on a flex device, through the extension.
+pub(super) fn relu(x: Tensor<2>) -> Tensor<2> {
+    Tensor::from_dispatch(<Dispatch as LinearKernels>::kernel_relu(x.into_dispatch()))
 }
 
 /// [`super::linear`] on a flex device, through the extension, which burn routes to

@@ -36,23 +36,6 @@ impl ActivationOps<Flex> for Flex {
         // Zero the gradient where the output was zero, but keep it for a NaN output:
         // the trait default masks with `float_lower_equal_elem(output, 0)`, which is
         // false for NaN.
-        // Patch 5: an f32 gradient owned here and laid out as the output is masked in
-        // place on every thread (the same values as `binary_op`, without a new buffer).
-        let mut grad = grad;
-        if output.dtype() == burn_backend::DType::F32
-            && grad.dtype() == burn_backend::DType::F32
-            && grad.layout().shape() == output.layout().shape()
-            && grad.is_unique()
-            && let (Some((0, g_end)), Some((o_start, o_end))) =
-                (grad.layout().contiguous_offsets(), output.layout().contiguous_offsets())
-        {
-            let out: &[f32] = &output.storage()[o_start..o_end];
-            let g: &mut [f32] = &mut grad.storage_mut()[..g_end];
-            crate::par_elementwise::zip_inplace(g, out, |g, out: f32| {
-                if out.is_nan() || out > 0.0 { g } else { 0.0 }
-            });
-            return grad;
-        }
         binary_op(
             output,
             grad,

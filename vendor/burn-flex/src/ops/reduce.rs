@@ -1120,37 +1120,6 @@ fn reduce_first_dim_f32(
     inner_size: usize, // number of columns (output positions)
     dim_stride: isize, // stride between rows
 ) -> Vec<f32> {
-    // Patch 5: a long first dimension (a bias gradient summed over the batch) is summed in
-    // blocks of rows on every thread, the blocks' partials added in block order. The block
-    // count depends on the shape alone, so the value does not depend on the thread count.
-    #[cfg(all(feature = "simd", feature = "rayon"))]
-    {
-        const BLOCK_ROWS: usize = 4096;
-        let blocks = (dim_size / BLOCK_ROWS).min(16);
-        if blocks >= 2 && dim_size * inner_size >= crate::par_elementwise::PAR_MIN_ELEMS {
-            use rayon::prelude::*;
-            let partials: Vec<Vec<f32>> = (0..blocks)
-                .into_par_iter()
-                .map(|b| {
-                    let (r0, r1) = (b * dim_size / blocks, (b + 1) * dim_size / blocks);
-                    let mut part = aligned::alloc_aligned_zeroed::<f32>(inner_size);
-                    kernels::scatter_add_f32(
-                        &data[start_offset + r0 * dim_stride as usize..],
-                        &mut part,
-                        r1 - r0,
-                        inner_size,
-                        dim_stride as usize,
-                    );
-                    aligned::to_vec(part)
-                })
-                .collect();
-            let mut result = partials[0].clone();
-            for part in &partials[1..] {
-                result.iter_mut().zip(part).for_each(|(r, p)| *r += p);
-            }
-            return result;
-        }
-    }
     #[cfg(feature = "simd")]
     {
         // Use aligned allocation for optimal SIMD scatter-add
