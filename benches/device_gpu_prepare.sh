@@ -18,7 +18,7 @@ fi
 # The example, the bench and the test in one build, one feature set (their dev-dependencies
 # join it; the bench profile is the release profile); the example also makes the scenes there
 # (`--prepare`), so no xtask travels.
-cargo build --release -p experiments -p brdf-neural --features experiments/wgpu \
+cargo build --release -p sweep -p brdf-neural --features sweep/wgpu \
     --example profile_steps --bench train_step --test gpu_backend
 
 newest() { find target/release/deps -maxdepth 1 -type f -executable -name "$1-*" -printf '%T@ %p\n' | sort -n | tail -1 | cut -d' ' -f2; }

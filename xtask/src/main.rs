@@ -18,6 +18,7 @@ mod reproduce;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
+use experiments::cli::{RunCommand, parse_backend};
 use experiments::{Backend, MatmulPrecision};
 use std::path::PathBuf;
 
@@ -107,7 +108,7 @@ enum Command {
     /// (Markdown, LaTeX) and figures (PNG) into OUT/tables and OUT/figures.
     ReproduceTables {
         /// Built-in profile (default, quick, smoke, runtime, full, real) or a profile TOML file.
-        #[arg(long, default_value = experiments::sweep::DEFAULT_PROFILE)]
+        #[arg(long, default_value = sweep::DEFAULT_PROFILE)]
         profile: String,
         /// Output directory (scenes, runs, cache, tables, figures).
         #[arg(long, default_value = "out/reproduce")]
@@ -209,6 +210,10 @@ enum Command {
     },
     /// Print the workspace's crates in layering order (bottom first).
     Layers,
+    /// The commands on one run directory (fit, eval, energy, export, export-merl): the same
+    /// as the `experiments` binary's.
+    #[command(flatten)]
+    Run(RunCommand),
 }
 
 /// `--matmul-precision`: `f32` or `bf16`.
@@ -218,11 +223,6 @@ fn parse_precision(name: &str) -> std::result::Result<MatmulPrecision, String> {
         "bf16" => Ok(MatmulPrecision::Bf16),
         other => Err(format!("unknown precision {other:?} (f32, bf16)")),
     }
-}
-
-/// `--backend`: a backend name (see `brdf_neural::device`).
-fn parse_backend(name: &str) -> std::result::Result<Backend, String> {
-    Backend::parse(name).map_err(|e| e.to_string())
 }
 
 fn main() -> Result<()> {
@@ -295,6 +295,7 @@ fn main() -> Result<()> {
                 println!("{c}");
             }
         }
+        Command::Run(command) => experiments::cli::run(command)?,
     }
     Ok(())
 }

@@ -15,7 +15,7 @@
 //! version`) fails when [`CODE_VERSION`] changes and the documents were not regenerated.
 
 use anyhow::{Context, Result, bail, ensure};
-use experiments::sweep::plan::CODE_VERSION;
+use run_format::CODE_VERSION;
 use std::path::Path;
 
 /// The opening marker's fixed start.

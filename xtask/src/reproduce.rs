@@ -1,11 +1,11 @@
 //! `cargo xtask reproduce-tables`, `collect` and `run-one`: the paper's results from one
-//! command (see `experiments::sweep` for the profiles, the run layout and the tables).
+//! command (see the `sweep` crate for the profiles, the run layout and the tables).
 
 use anyhow::{Context, Result};
-use experiments::run_dir::SweepLayout;
-use experiments::sweep::{self, Execution, SweepProfile};
 use experiments::{Backend, MatmulPrecision};
+use run_format::run_dir::SweepLayout;
 use std::path::{Path, PathBuf};
+use sweep::{Execution, SweepProfile};
 
 /// Options of `reproduce-tables`.
 pub struct Options {
@@ -51,7 +51,7 @@ pub fn reproduce(opts: Options) -> Result<()> {
     );
     let mut profile = SweepProfile::load(&opts.profile)?;
     if let Some(precision) = opts.matmul_precision {
-        profile = profile.with_matmul_precision(precision)?;
+        profile = profile.with_matmul_precision(precision);
     }
     eprintln!("profile {}: {}", profile.name, profile.description);
     // One sweep at a time per output directory, held through the tables; taking it removes

@@ -1,6 +1,6 @@
 //! A sweep whose output goes to a file (CI, Slurm, nohup) prints plain progress lines: a line
 //! at each run's end and at least every `NEURAL_BRDF_PROGRESS_SECS` in between, with the runs
-//! done of the total, the running runs and the time left (`experiments::sweep::heartbeat`).
+//! done of the total, the running runs and the time left (`sweep::heartbeat`).
 
 use std::process::{Command, Stdio};
 

@@ -46,7 +46,7 @@ struct Case {
 impl Case {
     fn new(name: &'static str, kind: ModelKind, n: usize, device: &Device) -> Self {
         let c = ModelConfig::new(kind);
-        let BrdfModel::Parametric(model) = c.init(device).expect("model") else {
+        let BrdfModel::Parametric(model) = BrdfModel::init(&c, device).expect("model") else {
             panic!("{kind:?} is not parametric")
         };
         let mut state = 0x9e37_79b9_7f4a_7c15_u64;

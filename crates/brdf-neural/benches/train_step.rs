@@ -140,11 +140,12 @@ impl Step {
         let l: Vec<_> = (0..n).map(|_| dir()).collect();
         let v: Vec<_> = (0..n).map(|_| dir()).collect();
         let spatial: Vec<f32> = (0..n * c.spatial_dim).map(|_| 2.0 * uniform() - 1.0).collect();
-        let batch = c.batch(&Samples { spatial: &spatial, l: &l, v: &v }, None, device).unwrap();
+        let batch =
+            BrdfBatch::new(c, &Samples { spatial: &spatial, l: &l, v: &v }, None, device).unwrap();
         let weight = Tensor::random([n, 1], Distribution::Uniform(0.0, 3.0), device);
         let target = Tensor::random([n, 3], Distribution::Uniform(0.0, 1.0), device);
         Self {
-            model: Some(c.init(device).unwrap()),
+            model: Some(BrdfModel::init(c, device).unwrap()),
             optim: AdamConfig::new().init(),
             batch,
             weight,

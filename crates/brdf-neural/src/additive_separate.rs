@@ -3,10 +3,11 @@
 //! hidden layer 2; f_d = sigmoid / pi, f_s = 0.5 softplus. Enhanced: the specular MLP also
 //! outputs xi in [0, 1]^3 and f = (1 - xi) f_d + f_s.
 //!
-//! NOL ablation: the specular MLP has 2 hidden layers and no skip. NeRFactor ablations: albedo
-//! clamped into [0.0023, 0.6038], scalar specular.
+//! NeRFactor ablations: albedo clamped into [0.0023, 0.6038], scalar specular. The layer table
+//! (and the NOL ablation's: the specular MLP has 2 hidden layers and no skip) is
+//! [`model_spec::layers::additive_separate_configs`].
 
-use crate::mlp::{Mlp, MlpConfig};
+use crate::mlp::Mlp;
 use crate::output::{AdditiveHead, BrdfOutput};
 use burn::module::Module;
 use burn::tensor::Tensor;
@@ -20,24 +21,6 @@ pub struct AdditiveSeparate {
     pub specular: Mlp,
     #[module(skip)]
     head: AdditiveHead,
-}
-
-/// The two MLP configurations (diffuse, specular).
-pub(crate) fn additive_separate_configs(c: &crate::ModelConfig) -> (MlpConfig, MlpConfig) {
-    let head = c.additive_head();
-    let mut d = MlpConfig::new(c.spatial_dim);
-    d.width = c.width;
-    d.hidden_layers = 4;
-    d.d_output = Some(3);
-    d.skip_into = Some(c.separate_skip_at + 1);
-    let mut s = d.clone();
-    s.d_output = Some(head.specular_outputs());
-    s.d_late = c.angles.dim();
-    if c.nol {
-        s.hidden_layers = 2;
-        s.skip_into = None;
-    }
-    (d, s)
 }
 
 impl AdditiveSeparate {

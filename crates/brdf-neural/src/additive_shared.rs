@@ -3,10 +3,11 @@
 //! (one hidden layer, then 3 outputs, sigmoid / pi) and a specular head (input [feature,
 //! PE(angles)], two hidden layers, then 3 outputs, 0.5 softplus; +3 for xi when enhanced).
 //!
-//! NOL ablation: trunk 3 layers (no skip: layer 3 does not exist), heads +2 hidden layers each,
-//! so the directions pass through 4 layers.
+//! The layer table (and the NOL ablation's: trunk 3 layers, no skip, heads +2 hidden layers
+//! each, so the directions pass through 4 layers) is
+//! [`model_spec::layers::additive_shared_configs`].
 
-use crate::mlp::{Mlp, MlpConfig};
+use crate::mlp::Mlp;
 use crate::output::{AdditiveHead, BrdfOutput};
 use burn::module::Module;
 use burn::tensor::Tensor;
@@ -22,25 +23,6 @@ pub struct AdditiveShared {
     pub specular: Mlp,
     #[module(skip)]
     head: AdditiveHead,
-}
-
-/// The trunk, diffuse-head and specular-head configurations.
-pub(crate) fn additive_shared_configs(c: &crate::ModelConfig) -> (MlpConfig, MlpConfig, MlpConfig) {
-    let head = c.additive_head();
-    let extra = if c.nol { 2 } else { 0 };
-    let mut t = MlpConfig::new(c.spatial_dim);
-    t.width = c.width;
-    t.hidden_layers = if c.nol { 3 } else { 5 };
-    t.skip_into = (c.skip_layer < t.hidden_layers).then_some(c.skip_layer);
-    let mut d = MlpConfig::new(c.width);
-    d.width = c.width;
-    d.hidden_layers = c.shared_diffuse_head_layers + extra;
-    d.d_output = Some(3);
-    let mut s = d.clone();
-    s.hidden_layers = 2 + extra;
-    s.d_output = Some(head.specular_outputs());
-    s.d_late = c.angles.dim();
-    (t, d, s)
 }
 
 impl AdditiveShared {

@@ -11,9 +11,8 @@
 //!
 //! A training loop on a GPU keeps the feature rows of all its surface points on the device
 //! ([`SpatialTable`], sanitised once) and selects each batch's rows there
-//! ([`ModelConfig::batch_from_table`]): the same values as gathering them on the CPU and
-//! uploading them with every batch ([`ModelConfig::batch_owned`]), without the copy and the
-//! transfer.
+//! ([`BrdfBatch::from_table`]): the same values as gathering them on the CPU and uploading
+//! them with every batch ([`BrdfBatch::from_owned`]), without the copy and the transfer.
 
 use crate::tensor_brdf::Geometry;
 use crate::{Error, ModelConfig, ModelKind, Result};
@@ -45,7 +44,7 @@ pub struct BrdfBatch {
 }
 
 /// The spatial feature rows of a set of surface points on the device, sanitised, for
-/// [`ModelConfig::batch_from_table`].
+/// [`BrdfBatch::from_table`].
 #[derive(Clone, Debug)]
 pub struct SpatialTable {
     /// `[points, spatial_dim]`.
@@ -80,11 +79,11 @@ fn sanitise(values: &mut [f32]) {
         .for_each(|x| *x = if x.is_nan() { 0.0 } else { x.clamp(-SPATIAL_LIMIT, SPATIAL_LIMIT) });
 }
 
-impl ModelConfig {
-    /// Uploads the feature rows of a set of points (row-major `[points, spatial_dim]`),
-    /// sanitised, for [`ModelConfig::batch_from_table`].
-    pub fn spatial_table(&self, rows: &[f32], device: &Device) -> Result<SpatialTable> {
-        let k = self.spatial_dim;
+impl SpatialTable {
+    /// Uploads the feature rows of a set of points (row-major `[points, spatial_dim]` of
+    /// `config`), sanitised, for [`BrdfBatch::from_table`].
+    pub fn new(config: &ModelConfig, rows: &[f32], device: &Device) -> Result<SpatialTable> {
+        let k = config.spatial_dim;
         if k == 0 || !rows.len().is_multiple_of(k) {
             return Err(Error::BatchShape(format!(
                 "a spatial table of {} values for spatial_dim {k}",
@@ -97,12 +96,53 @@ impl ModelConfig {
         let rows = Tensor::from_data(TensorData::new(rows, [points, k]), device);
         Ok(SpatialTable { rows, points })
     }
+}
 
-    /// [`ModelConfig::batch`] with the spatial features of sample i the row `points[i]` of
-    /// `table`, selected on the device: the same values as `batch` with those rows gathered on
+impl BrdfBatch {
+    /// Uploads a batch for the model of `config`. `swap[i]` swaps l and v in the network input
+    /// of sample i (training with [`crate::Reciprocity::RandomSwap`]; see
+    /// [`crate::AngleConfig::swap_mask`]); the geometry of parametric models always uses the
+    /// true directions.
+    pub fn new(
+        config: &ModelConfig,
+        s: &Samples,
+        swap: Option<&[bool]>,
+        device: &Device,
+    ) -> Result<BrdfBatch> {
+        Self::from_owned(config, s.spatial.to_vec(), s.l, s.v, swap, device)
+    }
+
+    /// [`BrdfBatch::new`] for spatial features the caller hands over (a freshly gathered
+    /// training batch): they are sanitised in place and become the tensor's storage, with no
+    /// copy. The same values as `new` with `Samples { spatial: &spatial, l, v }`.
+    pub fn from_owned(
+        config: &ModelConfig,
+        mut spatial: Vec<f32>,
+        l: &[[f32; 3]],
+        v: &[[f32; 3]],
+        swap: Option<&[bool]>,
+        device: &Device,
+    ) -> Result<BrdfBatch> {
+        let n = l.len();
+        if v.len() != n || spatial.len() != n * config.spatial_dim {
+            return Err(Error::BatchShape(format!(
+                "{} light and {} view directions, {} spatial values for spatial_dim {}",
+                n,
+                v.len(),
+                spatial.len(),
+                config.spatial_dim
+            )));
+        }
+        sanitise(&mut spatial);
+        let spatial = Tensor::from_data(TensorData::new(spatial, [n, config.spatial_dim]), device);
+        Self::with_spatial(config, spatial, l, v, swap, device)
+    }
+
+    /// [`BrdfBatch::new`] with the spatial features of sample i the row `points[i]` of
+    /// `table`, selected on the device: the same values as `new` with those rows gathered on
     /// the CPU.
-    pub fn batch_from_table(
-        &self,
+    pub fn from_table(
+        config: &ModelConfig,
         table: &SpatialTable,
         points: &[u32],
         l: &[[f32; 3]],
@@ -112,11 +152,11 @@ impl ModelConfig {
     ) -> Result<BrdfBatch> {
         let n = l.len();
         let [_, k] = table.rows.dims();
-        if points.len() != n || k != self.spatial_dim {
+        if points.len() != n || k != config.spatial_dim {
             return Err(Error::BatchShape(format!(
                 "{} points for {n} samples, a table of width {k} for spatial_dim {}",
                 points.len(),
-                self.spatial_dim
+                config.spatial_dim
             )));
         }
         if let Some(&p) = points.iter().find(|&&p| p as usize >= table.points) {
@@ -128,46 +168,12 @@ impl ModelConfig {
         let index: Vec<i32> = points.iter().map(|&p| p as i32).collect();
         let index = Tensor::<1, Int>::from_data(TensorData::new(index, [n]), device);
         let spatial = table.rows.clone().select(0, index);
-        self.batch_with_spatial(spatial, l, v, swap, device)
-    }
-
-    /// Uploads a batch for this model. `swap[i]` swaps l and v in the network input of sample
-    /// i (training with [`crate::Reciprocity::RandomSwap`]; see
-    /// [`crate::AngleConfig::swap_mask`]); the geometry of parametric models always uses the
-    /// true directions.
-    pub fn batch(&self, s: &Samples, swap: Option<&[bool]>, device: &Device) -> Result<BrdfBatch> {
-        self.batch_owned(s.spatial.to_vec(), s.l, s.v, swap, device)
-    }
-
-    /// [`ModelConfig::batch`] for spatial features the caller hands over (a freshly gathered
-    /// training batch): they are sanitised in place and become the tensor's storage, with no
-    /// copy. The same values as `batch` with `Samples { spatial: &spatial, l, v }`.
-    pub fn batch_owned(
-        &self,
-        mut spatial: Vec<f32>,
-        l: &[[f32; 3]],
-        v: &[[f32; 3]],
-        swap: Option<&[bool]>,
-        device: &Device,
-    ) -> Result<BrdfBatch> {
-        let n = l.len();
-        if v.len() != n || spatial.len() != n * self.spatial_dim {
-            return Err(Error::BatchShape(format!(
-                "{} light and {} view directions, {} spatial values for spatial_dim {}",
-                n,
-                v.len(),
-                spatial.len(),
-                self.spatial_dim
-            )));
-        }
-        sanitise(&mut spatial);
-        let spatial = Tensor::from_data(TensorData::new(spatial, [n, self.spatial_dim]), device);
-        self.batch_with_spatial(spatial, l, v, swap, device)
+        Self::with_spatial(config, spatial, l, v, swap, device)
     }
 
     /// The batch of the spatial rows `spatial` (on the device) and the directions.
-    fn batch_with_spatial(
-        &self,
+    fn with_spatial(
+        config: &ModelConfig,
         spatial: Tensor<2>,
         l: &[[f32; 3]],
         v: &[[f32; 3]],
@@ -181,13 +187,13 @@ impl ModelConfig {
         if swap.is_some_and(|m| m.len() != n) {
             return Err(Error::BatchShape("swap mask length differs from the batch".into()));
         }
-        let angles = self.uses_angle_features().then(|| {
-            let d = self.angles.dim();
-            let a = self.angles.encode_batch(l, v, swap);
+        let angles = config.uses_angle_features().then(|| {
+            let d = config.angles.dim();
+            let a = config.angles.encode_batch(l, v, swap);
             Tensor::from_data(TensorData::new(a, [n, d]), device)
         });
-        let geometry = (!self.uses_angle_features())
-            .then(|| Geometry::new(l, v, self.kind == ModelKind::Fmbrdf, device));
+        let geometry = (!config.uses_angle_features())
+            .then(|| Geometry::new(l, v, config.kind == ModelKind::Fmbrdf, device));
         Ok(BrdfBatch { spatial, angles, geometry })
     }
 }
@@ -197,7 +203,7 @@ mod tests {
     use super::*;
     use crate::{ModelConfig, ModelKind};
 
-    /// `batch_owned` (the training path, sanitising in place) gives the tensors `batch` gives
+    /// `from_owned` (the training path, sanitising in place) gives the tensors `new` gives
     /// (sanitising a copy), bit for bit, for every kind of input: NaN, infinities, huge values.
     #[test]
     fn owned_and_borrowed_batches_agree_bitwise() {
@@ -217,8 +223,9 @@ mod tests {
             let v: Vec<[f32; 3]> = (0..n).map(|i| dir(i, 1.1)).collect();
             let swap: Vec<bool> = (0..n).map(|i| i % 3 == 0).collect();
             let s = Samples { spatial: &spatial, l: &l, v: &v };
-            let a = config.batch(&s, Some(&swap), &device).unwrap();
-            let b = config.batch_owned(spatial.clone(), &l, &v, Some(&swap), &device).unwrap();
+            let a = BrdfBatch::new(&config, &s, Some(&swap), &device).unwrap();
+            let b = BrdfBatch::from_owned(&config, spatial.clone(), &l, &v, Some(&swap), &device)
+                .unwrap();
             let bits = |t: &Tensor<2>| -> Vec<u32> {
                 t.clone()
                     .into_data()
@@ -239,8 +246,14 @@ mod tests {
         }
         let config = ModelConfig { spatial_dim: 7, ..Default::default() };
         let l = [[0.0, 0.0, 1.0]];
-        assert!(config.batch_owned(vec![0.0; 6], &l, &l, None, &device).is_err(), "short rows");
-        assert!(config.batch_owned(vec![0.0; 7], &l, &l, Some(&[]), &device).is_err(), "mask");
+        assert!(
+            BrdfBatch::from_owned(&config, vec![0.0; 6], &l, &l, None, &device).is_err(),
+            "short rows"
+        );
+        assert!(
+            BrdfBatch::from_owned(&config, vec![0.0; 7], &l, &l, Some(&[]), &device).is_err(),
+            "mask"
+        );
     }
 
     /// Rows selected from a [`SpatialTable`] on the device give the batch that gathering
@@ -271,28 +284,42 @@ mod tests {
         };
         for kind in [ModelKind::SingleMlp, ModelKind::Disney, ModelKind::Fmbrdf] {
             let config = ModelConfig { kind, spatial_dim: k, ..Default::default() };
-            let t = config.spatial_table(&table, &device).unwrap();
+            let t = SpatialTable::new(&config, &table, &device).unwrap();
             assert_eq!(t.points(), points);
-            let a = config.batch_owned(gathered.clone(), &l, &v, Some(&swap), &device).unwrap();
-            let b = config.batch_from_table(&t, &rows, &l, &v, Some(&swap), &device).unwrap();
+            let a = BrdfBatch::from_owned(&config, gathered.clone(), &l, &v, Some(&swap), &device)
+                .unwrap();
+            let b =
+                BrdfBatch::from_table(&config, &t, &rows, &l, &v, Some(&swap), &device).unwrap();
             assert_eq!(bits(a.spatial.clone()), bits(b.spatial.clone()), "{kind:?} spatial");
             if let (Some(x), Some(y)) = (&a.angles, &b.angles) {
                 assert_eq!(bits(x.clone()), bits(y.clone()), "{kind:?} angles");
             }
             assert_eq!(a.angles.is_some(), b.angles.is_some());
-            let model = config.init(&device).unwrap();
+            let model = crate::BrdfModel::init(&config, &device).unwrap();
             let (fa, fb) = (model.forward(&a), model.forward(&b));
             assert_eq!(bits(fa.f), bits(fb.f), "{kind:?} output");
         }
         let config = ModelConfig { spatial_dim: k, ..Default::default() };
-        let t = config.spatial_table(&table, &device).unwrap();
+        let t = SpatialTable::new(&config, &table, &device).unwrap();
         let one = [[0.0, 0.0, 1.0]];
         let far = [points as u32];
-        assert!(config.batch_from_table(&t, &far, &one, &one, None, &device).is_err(), "point");
-        assert!(config.batch_from_table(&t, &[0, 1], &one, &one, None, &device).is_err(), "len");
-        assert!(config.batch_from_table(&t, &[0], &one, &[], None, &device).is_err(), "views");
-        assert!(config.spatial_table(&table[..k + 1], &device).is_err(), "ragged table");
+        assert!(
+            BrdfBatch::from_table(&config, &t, &far, &one, &one, None, &device).is_err(),
+            "point"
+        );
+        assert!(
+            BrdfBatch::from_table(&config, &t, &[0, 1], &one, &one, None, &device).is_err(),
+            "len"
+        );
+        assert!(
+            BrdfBatch::from_table(&config, &t, &[0], &one, &[], None, &device).is_err(),
+            "views"
+        );
+        assert!(SpatialTable::new(&config, &table[..k + 1], &device).is_err(), "ragged table");
         let wide = ModelConfig { spatial_dim: k + 1, ..Default::default() };
-        assert!(wide.batch_from_table(&t, &[0], &one, &one, None, &device).is_err(), "width");
+        assert!(
+            BrdfBatch::from_table(&wide, &t, &[0], &one, &one, None, &device).is_err(),
+            "width"
+        );
     }
 }

@@ -29,5 +29,32 @@ pub enum Error {
     BatchShape(String),
 }
 
+/// The configuration errors of `model-spec` become the variants of the same names (and the
+/// same messages).
+impl From<model_spec::Error> for Error {
+    fn from(e: model_spec::Error) -> Self {
+        match e {
+            model_spec::Error::InvalidConfig(m) => Error::InvalidConfig(m),
+            model_spec::Error::UnknownModel(m) => Error::UnknownModel(m),
+        }
+    }
+}
+
 /// `Result` with this crate's [`Error`].
 pub type Result<T> = std::result::Result<T, Error>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn model_spec_errors_keep_their_messages() {
+        for e in [
+            model_spec::Error::InvalidConfig("width must be positive".into()),
+            model_spec::Error::UnknownModel("mlp".into()),
+        ] {
+            let text = e.to_string();
+            assert_eq!(Error::from(e).to_string(), text);
+        }
+    }
+}

@@ -7,7 +7,7 @@
 //! The backward pass differentiates the mean of every output the model has (f, and the
 //! additive models' parts and xi), so every parameter that reaches an output gets a gradient.
 
-use crate::{BrdfModel, ModelConfig, Result, Samples};
+use crate::{BrdfBatch, BrdfModel, ModelConfig, Result, Samples};
 use burn::module::{Module, ModuleVisitor, Param};
 use burn::optim::GradientsParams;
 use burn::tensor::{Device, Tensor};
@@ -109,7 +109,7 @@ pub fn check_forward_backward(
     samples: &Samples,
     device: &Device,
 ) -> Result<Checked> {
-    let batch = config.batch(samples, None, device)?;
+    let batch = BrdfBatch::new(config, samples, None, device)?;
     let out = model.forward(&batch);
     if let Some(problem) = first_bad_output(&out) {
         return Ok(Checked { problem: Some(problem), gradients: 0 });

@@ -10,43 +10,37 @@
 //! training uses the same device with `.autodiff()`.
 //!
 //! ```
-//! use brdf_neural::{ModelConfig, Samples};
+//! use brdf_neural::{BrdfBatch, BrdfModel, ModelConfig, Samples};
 //! // Any model by its configuration name or its paper row name.
 //! let mut config = ModelConfig::from_name("Enh. Add. Shared").unwrap();
 //! config.spatial_dim = 4;
 //! config.width = 16;
 //! let device = brdf_neural::device::cpu();
 //! // Seeded: the same seed gives the same initial weights, whatever other threads do.
-//! let model = config.init_seeded(&device, 7, None).unwrap();
+//! let model = BrdfModel::init_seeded(&config, &device, 7, None).unwrap();
 //! let (l, v) = ([[0.0, 0.6, 0.8_f32]], [[0.0, -0.6, 0.8_f32]]);
 //! let samples = Samples { spatial: &[0.1, -0.2, 0.3, 0.0], l: &l, v: &v };
-//! let out = model.forward(&config.batch(&samples, None, &device).unwrap());
+//! let out = model.forward(&BrdfBatch::new(&config, &samples, None, &device).unwrap());
 //! assert_eq!(out.f.dims(), [1, 3]);
 //! assert!(out.diffuse.is_some() && out.xi.is_some());
 //! ```
 //!
-//! Configuration (serde, TOML): [`ModelConfig`] with `kind` one of the [`ModelKind`] names
-//! (`rp`, `ts`, `fmbrdf`, `disney`, `single_mlp`, `additive_separate`, `additive_shared`,
-//! `additive_separate_enhanced`, `additive_shared_enhanced`); [`ModelKind::from_name`] also takes
-//! the paper's row names ("Single MLP", "Enh. Add. Sep.", ...).
+//! The models' vocabulary without tensors lives in the `model-spec` crate and is re-exported
+//! here under its old paths: [`ModelKind`], [`ModelConfig`] (serde, TOML; `kind` one of the
+//! [`ModelKind`] names `rp`, `ts`, `fmbrdf`, `disney`, `single_mlp`, `additive_separate`,
+//! `additive_shared`, `additive_separate_enhanced`, `additive_shared_enhanced`;
+//! [`ModelKind::from_name`] also takes the paper's row names "Single MLP", "Enh. Add. Sep.",
+//! ...), the direction features ([`features`]: [`AngleConfig`], [`AngleParametrization`],
+//! [`Reciprocity`]), [`Analytic`] and the layer tables ([`mlp::MlpConfig`] and
+//! [`ModelConfig::mlp_configs`]). This crate builds the models from them:
+//! [`BrdfModel::init`] and [`BrdfModel::init_seeded`], batches with [`BrdfBatch::new`] (and
+//! [`BrdfBatch::from_owned`], [`BrdfBatch::from_table`], [`BrdfBatch::from_records`]).
 //!
 //! # Parameter counts
 //!
-//! Default configurations (160 spatial inputs, width 128; angle features 21 values, 28 with the
-//! reciprocity mapping), printed by `cargo run -p brdf-neural --example param_counts` and
-//! checked against the modules by the tests:
-//!
-//! | model | default | mapping | NOL |
-//! | --- | ---: | ---: | ---: |
-//! | RP | 108,039 | | |
-//! | TS | 108,039 | | |
-//! | FMBRDF | 107,912 (incl. 2 global) | | |
-//! | Disney | 108,684 | | |
-//! | Single MLP | 112,899 | 114,691 | 110,211 |
-//! | Add. Sep. | 187,398 | 189,190 | 131,206 |
-//! | Add. Shared | 160,134 | 161,030 | 172,678 |
-//! | Enh. Add. Sep. | 187,785 | 189,577 | 131,593 |
-//! | Enh. Add. Shared | 160,521 | 161,417 | 173,065 |
+//! The parameter count of every default configuration is tabulated in the crate docs of
+//! [`model_spec`] (`cargo run -p model-spec --example param_counts` prints it); the tests here
+//! check [`ModelConfig::param_count`] against the modules built.
 //!
 //! # Backends and performance
 //!
@@ -72,7 +66,8 @@ pub mod additive_shared;
 pub mod batch;
 pub mod device;
 mod error;
-pub mod features;
+// The direction features, defined in model-spec, under their old path.
+pub use model_spec::features;
 pub mod finite_check;
 #[cfg(feature = "flex")]
 mod flex_linear;

@@ -1,5 +1,6 @@
 //! What a model returns, and the output nonlinearities shared by the additive models.
 
+use crate::ModelConfig;
 use burn::tensor::Tensor;
 use burn::tensor::activation::{sigmoid, softplus};
 use std::f32::consts::FRAC_1_PI;
@@ -35,13 +36,18 @@ pub(crate) struct AdditiveHead {
 }
 
 impl AdditiveHead {
-    /// Width of the specular network's output.
-    pub fn specular_outputs(&self) -> usize {
-        (if self.scalar_specular { 1 } else { 3 }) + if self.enhanced { 3 } else { 0 }
+    /// The additive output head of the configuration `c`.
+    pub fn of(c: &ModelConfig) -> Self {
+        AdditiveHead {
+            albedo_clamp: c.albedo_clamp,
+            scalar_specular: c.scalar_specular,
+            enhanced: c.kind.is_enhanced(),
+            specular_scale: c.specular_softplus_scale as f32,
+        }
     }
 
-    /// Combines the raw diffuse `[batch, 3]` and specular `[batch, specular_outputs()]`
-    /// outputs.
+    /// Combines the raw diffuse `[batch, 3]` and specular `[batch, k]` outputs, k the width
+    /// [`model_spec::layers::specular_outputs`] gives the specular network.
     pub fn combine(&self, diffuse_raw: Tensor<2>, specular_raw: Tensor<2>) -> BrdfOutput {
         let s = sigmoid(diffuse_raw);
         let fd = if self.albedo_clamp {

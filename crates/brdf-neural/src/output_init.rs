@@ -159,7 +159,7 @@ impl BrdfModel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{ModelConfig, ModelKind, Samples};
+    use crate::{BrdfBatch, ModelConfig, ModelKind, Samples};
 
     #[test]
     fn inverses_invert() {
@@ -198,8 +198,8 @@ mod tests {
         ] {
             let mut config = ModelConfig::new(kind);
             config.spatial_dim = 8;
-            let model = config.init(&device).unwrap().with_initial_brdf(f0);
-            let batch = config.batch(&samples, None, &device).unwrap();
+            let model = BrdfModel::init(&config, &device).unwrap().with_initial_brdf(f0);
+            let batch = BrdfBatch::new(&config, &samples, None, &device).unwrap();
             let f: Vec<f32> = model.forward(&batch).f.into_data().try_to_vec::<f32>().unwrap();
             for (c, want) in f0.iter().enumerate() {
                 let mean = f.iter().skip(c).step_by(3).sum::<f32>() / n as f32;
@@ -240,12 +240,12 @@ mod tests {
         for kind in [ModelKind::Rp, ModelKind::Ts, ModelKind::Disney] {
             let mut config = ModelConfig::new(kind);
             config.spatial_dim = 8;
-            let batch = config.batch(&samples, None, &device).unwrap();
+            let batch = BrdfBatch::new(&config, &samples, None, &device).unwrap();
             let predict = |model: BrdfModel| -> Vec<f32> {
                 model.forward(&batch).f.into_data().try_to_vec::<f32>().unwrap()
             };
-            let default = predict(config.init(&device).unwrap());
-            let started = predict(config.init(&device).unwrap().with_initial_brdf(f0));
+            let default = predict(BrdfModel::init(&config, &device).unwrap());
+            let started = predict(BrdfModel::init(&config, &device).unwrap().with_initial_brdf(f0));
             assert!(started.iter().all(|x| x.is_finite() && *x >= 0.0), "{kind:?}");
             for (c, want) in f0.iter().enumerate() {
                 let (got, before) = (mean(&started, c), mean(&default, c));

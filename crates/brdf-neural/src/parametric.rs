@@ -2,8 +2,9 @@
 //! spatial features of x to the parameters of an analytic BRDF, which a tensor twin of the
 //! `brdf-analytic` model then evaluates for the sample's directions.
 //!
-//! Output nonlinearities ("sigmoid or softplus depending on the range"; roughness scaled by 0.5
-//! before its sigmoid):
+//! The layer table and the columns of the MLP's output are `model-spec`'s
+//! ([`model_spec::layers`], with [`Analytic`], re-exported here). Output nonlinearities
+//! ("sigmoid or softplus depending on the range"; roughness scaled by 0.5 before its sigmoid):
 //!
 //! | model | outputs | mapping |
 //! | --- | --- | --- |
@@ -11,11 +12,8 @@
 //! | TS | 7 | r = sigmoid(0.5 z), rho_d = sigmoid (RGB), F0 = sigmoid (RGB) |
 //! | Disney | 12 | base colour (RGB) and the 9 scalars, all sigmoid; roughness sigmoid(0.5 z); anisotropic fixed to 0 (not predicted) |
 //! | FMBRDF | 6 + 2 global | eta = 1.1 + 1.4 sigmoid, rho = sigmoid (RGB), k_s = softplus, kappa = 100 sigmoid per point; alpha = 0.001 + (2 pi - 0.001) sigmoid(g a), beta = 0.5 + 3.5 sigmoid(g b) with a, b two trainable scalars per object and the gain g = [`FMBRDF_GLOBAL_GAIN`] |
-//!
-//! (The spec counts 13 Disney outputs: its 10 scalars include anisotropic, which the paper fixes
-//! to 0, so it is not an output here.)
 
-use crate::mlp::{Mlp, MlpConfig};
+use crate::mlp::Mlp;
 use crate::output::BrdfOutput;
 use crate::tensor_brdf::{
     DisneyTensorParams, FmbrdfNets, FmbrdfTensorParams, Geometry, PhongTensorParams,
@@ -24,33 +22,8 @@ use crate::tensor_brdf::{
 use burn::module::{Module, Param};
 use burn::tensor::activation::{sigmoid, softplus};
 use burn::tensor::{Device, Tensor, TensorData};
-use serde::{Deserialize, Serialize};
+pub use model_spec::Analytic;
 use std::f64::consts::TAU;
-
-/// Which analytic model a parametric model drives.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Analytic {
-    /// Realistic Phong.
-    RealisticPhong,
-    /// Torrance-Sparrow (GGX).
-    TorranceSparrow,
-    /// Isotropic Disney.
-    Disney,
-    /// Fresnel microfacet BRDF.
-    Fmbrdf,
-}
-
-impl Analytic {
-    /// Number of per-point MLP outputs.
-    pub fn outputs(self) -> usize {
-        match self {
-            Analytic::RealisticPhong | Analytic::TorranceSparrow => 7,
-            Analytic::Disney => 12,
-            Analytic::Fmbrdf => 6,
-        }
-    }
-}
 
 /// FMBRDF ranges of the global alpha and beta.
 pub const FMBRDF_ALPHA_RANGE: (f64, f64) = (0.001, TAU);
@@ -95,16 +68,6 @@ pub struct ParametricModel {
     analytic: Analytic,
     #[module(skip)]
     gamma_base_color: bool,
-}
-
-/// The parameter MLP's configuration.
-pub(crate) fn parametric_config(c: &crate::ModelConfig, analytic: Analytic) -> MlpConfig {
-    let mut m = MlpConfig::new(c.spatial_dim);
-    m.width = c.width;
-    m.hidden_layers = 5;
-    m.d_output = Some(analytic.outputs());
-    m.skip_into = Some(c.skip_layer);
-    m
 }
 
 fn logit(p: f64) -> f64 {

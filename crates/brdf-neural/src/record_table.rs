@@ -6,8 +6,8 @@
 //! device then waits for the host every step. The records never change, so [`RecordTable`]
 //! computes those inputs once for every record, with the same functions
 //! ([`crate::AngleConfig::encode_batch`], [`Geometry::new`]), and a batch selects its rows on
-//! the device from one uploaded index ([`ModelConfig::batch_from_records`]), together with its
-//! spatial rows ([`SpatialTable`]). The values are the ones the per-step path computes, to the
+//! the device from one uploaded index ([`BrdfBatch::from_records`]), together with its spatial
+//! rows ([`SpatialTable`]). The values are the ones the per-step path computes, to the
 //! bit; tests compare batches, and a whole training run on the CPU.
 //!
 //! With the random-swap reciprocity option the angle table holds every record twice, as (l, v)
@@ -16,14 +16,14 @@
 //!
 //! Memory: `records x (angle_dim x (1 + swap) + 1)` floats for the purely neural models,
 //! `records x 17` for the parametric ones (32 for FMBRDF), the point included only with spatial
-//! features ([`ModelConfig::record_table_bytes`]).
+//! features ([`RecordTable::bytes`]).
 
 use crate::batch::SpatialTable;
 use crate::tensor_brdf::Geometry;
 use crate::{BrdfBatch, Error, ModelConfig, ModelKind, Reciprocity, Result};
 use burn::tensor::{Device, Int, Tensor, TensorData};
 
-/// The direction inputs of a set of records on the device ([`ModelConfig::record_table`]).
+/// The direction inputs of a set of records on the device ([`RecordTable::new`]).
 #[derive(Clone, Debug)]
 pub struct RecordTable {
     /// Number of records.
@@ -38,7 +38,7 @@ pub struct RecordTable {
     geometry: Option<Geometry>,
 }
 
-/// A batch's records, uploaded once: for [`ModelConfig::batch_from_records`] and for the
+/// A batch's records, uploaded once: for [`BrdfBatch::from_records`] and for the
 /// caller's own per-record tensors (weights, targets: select their rows with `rows`).
 #[derive(Clone, Debug)]
 pub struct RecordIndex {
@@ -95,24 +95,12 @@ impl RecordTable {
     }
 }
 
-impl ModelConfig {
-    /// Bytes [`ModelConfig::record_table`] puts on the device for `records` records.
-    pub fn record_table_bytes(&self, records: usize) -> usize {
-        let per_record = if self.uses_angle_features() {
-            let copies = if self.angles.reciprocity == Reciprocity::RandomSwap { 2 } else { 1 };
-            self.angles.dim() * copies
-        } else if self.kind == ModelKind::Fmbrdf {
-            16 + 9 + 6
-        } else {
-            16
-        };
-        records * (per_record + usize::from(self.spatial_dim > 0)) * 4
-    }
-
+impl RecordTable {
     /// Computes the direction inputs of every record (local-frame `l[i]`, `v[i]`, at surface
-    /// point `point[i]`) and uploads them, for [`ModelConfig::batch_from_records`].
-    pub fn record_table(
-        &self,
+    /// point `point[i]`) for the model of `config` and uploads them, for
+    /// [`BrdfBatch::from_records`].
+    pub fn new(
+        config: &ModelConfig,
         l: &[[f32; 3]],
         v: &[[f32; 3]],
         point: &[u32],
@@ -129,37 +117,53 @@ impl ModelConfig {
         if records > (i32::MAX / 2) as usize {
             return Err(Error::BatchShape(format!("{records} records: too many for a table")));
         }
-        let swaps = self.angles.reciprocity == Reciprocity::RandomSwap;
-        let angles = self.uses_angle_features().then(|| {
-            let d = self.angles.dim();
-            let mut a = self.angles.encode_batch(l, v, None);
+        let swaps = config.angles.reciprocity == Reciprocity::RandomSwap;
+        let angles = config.uses_angle_features().then(|| {
+            let d = config.angles.dim();
+            let mut a = config.angles.encode_batch(l, v, None);
             if swaps {
-                a.extend(self.angles.encode_batch(v, l, None));
+                a.extend(config.angles.encode_batch(v, l, None));
             }
             let rows = a.len() / d;
             Tensor::from_data(TensorData::new(a, [rows, d]), device)
         });
-        let geometry = (!self.uses_angle_features())
-            .then(|| Geometry::new(l, v, self.kind == ModelKind::Fmbrdf, device));
-        let point = (self.spatial_dim > 0).then(|| {
+        let geometry = (!config.uses_angle_features())
+            .then(|| Geometry::new(l, v, config.kind == ModelKind::Fmbrdf, device));
+        let point = (config.spatial_dim > 0).then(|| {
             let p: Vec<i32> = point.iter().map(|&p| p as i32).collect();
             Tensor::<1, Int>::from_data(TensorData::new(p, [records]), device)
         });
         Ok(RecordTable { records, point, angles, swaps, geometry })
     }
 
+    /// Bytes [`RecordTable::new`] puts on the device for `records` records of the model of
+    /// `config`.
+    pub fn bytes(config: &ModelConfig, records: usize) -> usize {
+        let per_record = if config.uses_angle_features() {
+            let copies = if config.angles.reciprocity == Reciprocity::RandomSwap { 2 } else { 1 };
+            config.angles.dim() * copies
+        } else if config.kind == ModelKind::Fmbrdf {
+            16 + 9 + 6
+        } else {
+            16
+        };
+        records * (per_record + usize::from(config.spatial_dim > 0)) * 4
+    }
+}
+
+impl BrdfBatch {
     /// The batch of the records `index` (made by `table`), selected on the device: the batch
-    /// [`ModelConfig::batch_owned`] makes from the same records' rows and directions. `spatial`
+    /// [`BrdfBatch::from_owned`] makes from the same records' rows and directions. `spatial`
     /// holds the points' feature rows (required when the model has spatial features).
-    pub fn batch_from_records(
-        &self,
+    pub fn from_records(
+        config: &ModelConfig,
         table: &RecordTable,
         spatial: Option<&SpatialTable>,
         index: &RecordIndex,
         device: &Device,
     ) -> Result<BrdfBatch> {
         let n = index.host.len();
-        let spatial = match (self.spatial_dim, spatial, &table.point) {
+        let spatial = match (config.spatial_dim, spatial, &table.point) {
             (0, _, _) => Tensor::from_data(TensorData::new(Vec::<f32>::new(), [n, 0]), device),
             (k, Some(s), Some(point)) if s.width() == k => {
                 let points = point.clone().select(0, index.rows.clone());
@@ -232,14 +236,15 @@ mod tests {
                     rows[p * k..(p + 1) * k].to_vec()
                 })
                 .collect();
-            let spatial = (k > 0).then(|| config.spatial_table(&rows, &device).unwrap());
-            let table = config.record_table(&l, &v, &point, &device).unwrap();
+            let spatial = (k > 0).then(|| SpatialTable::new(&config, &rows, &device).unwrap());
+            let table = RecordTable::new(&config, &l, &v, &point, &device).unwrap();
             assert_eq!(table.records(), records);
             // A mask only with the random swap, as the trainer draws one.
             let mask = (reciprocity == Reciprocity::RandomSwap).then_some(&swap[..]);
             let index = table.index(&batch, mask, &device).unwrap();
-            let a = config.batch_owned(gathered, &bl, &bv, mask, &device).unwrap();
-            let b = config.batch_from_records(&table, spatial.as_ref(), &index, &device).unwrap();
+            let a = BrdfBatch::from_owned(&config, gathered, &bl, &bv, mask, &device).unwrap();
+            let b = BrdfBatch::from_records(&config, &table, spatial.as_ref(), &index, &device)
+                .unwrap();
             let name = format!("{kind:?} {reciprocity:?} k={k}");
             assert_eq!(bits(a.spatial.clone()), bits(b.spatial.clone()), "{name}: spatial");
             assert_eq!(a.angles.is_some(), b.angles.is_some(), "{name}");
@@ -247,20 +252,20 @@ mod tests {
                 assert_eq!(bits(x.clone()), bits(y.clone()), "{name}: angles");
             }
             assert_eq!(a.geometry.is_some(), b.geometry.is_some(), "{name}");
-            let model = config.init(&device).unwrap();
+            let model = crate::BrdfModel::init(&config, &device).unwrap();
             let (fa, fb) = (model.forward(&a), model.forward(&b));
             assert_eq!(bits(fa.f), bits(fb.f), "{name}: output");
-            let bytes = config.record_table_bytes(records);
+            let bytes = RecordTable::bytes(&config, records);
             assert!(bytes > 0 && bytes.is_multiple_of(4 * records), "{name}: {bytes} bytes");
         }
         let config = ModelConfig { spatial_dim: 5, ..Default::default() };
-        let table = config.record_table(&l, &v, &point, &device).unwrap();
+        let table = RecordTable::new(&config, &l, &v, &point, &device).unwrap();
         assert!(table.index(&[records as u32], None, &device).is_err(), "record outside");
         assert!(table.index(&[0, 1], Some(&[true]), &device).is_err(), "mask length");
         assert!(table.index(&[0], Some(&[true]), &device).is_err(), "a swap without swapped rows");
-        assert!(config.record_table(&l, &v[1..], &point, &device).is_err(), "lengths");
+        assert!(RecordTable::new(&config, &l, &v[1..], &point, &device).is_err(), "lengths");
         let index = table.index(&[0], None, &device).unwrap();
-        let no_rows = config.batch_from_records(&table, None, &index, &device);
+        let no_rows = BrdfBatch::from_records(&config, &table, None, &index, &device);
         assert!(no_rows.is_err(), "spatial features without a spatial table");
     }
 }

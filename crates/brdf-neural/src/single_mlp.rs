@@ -1,11 +1,11 @@
 //! Single MLP (spec 4.2): one 6 x 128 ReLU MLP with the input skip to layer 3 maps
-//! [spatial features, PE(angles)] to RGB through a softplus.
+//! [spatial features, PE(angles)] to RGB through a softplus, f = s softplus(z) with the scale
+//! s = `single_mlp_softplus_scale` (default 1).
 //!
-//! NOL ablation: the directions enter at linear layer `nol_layer` (default 3, the paper's
-//! "layer 4") instead of layer 0, so they pass through 3 instead of 6 layers; the spatial input
-//! still enters at layer 0 and the skip re-injects it (only it) at layer 3.
+//! The layer table, and where the NOL ablation feeds the directions in, is
+//! [`model_spec::layers::single_mlp_config`].
 
-use crate::mlp::{Mlp, MlpConfig};
+use crate::mlp::Mlp;
 use crate::output::BrdfOutput;
 use burn::module::Module;
 use burn::tensor::Tensor;
@@ -18,18 +18,6 @@ pub struct SingleMlp {
     pub mlp: Mlp,
     #[module(skip)]
     output_scale: f32,
-}
-
-/// The MLP configuration of a Single MLP.
-pub(crate) fn single_mlp_config(c: &crate::ModelConfig) -> MlpConfig {
-    let mut m = MlpConfig::new(c.spatial_dim);
-    m.width = c.width;
-    m.hidden_layers = 5;
-    m.d_output = Some(3);
-    m.skip_into = Some(c.skip_layer);
-    m.d_late = c.angles.dim();
-    m.late_into = if c.nol { c.nol_layer } else { 0 };
-    m
 }
 
 impl SingleMlp {

@@ -150,7 +150,7 @@ fn fresh_models_are_finite_forward_and_backward_on_adversarial_inputs() {
     let t = Instant::now();
     let variants = variants();
     for c in &variants {
-        let model = c.init_seeded(&device, SEED, None).unwrap();
+        let model = BrdfModel::init_seeded(c, &device, SEED, None).unwrap();
         stress(&model, c, "fresh", n, &device);
     }
     eprintln!(
@@ -168,7 +168,7 @@ fn trained_models_stay_finite_forward_and_backward_on_adversarial_inputs() {
     let variants = variants();
     for c in &variants {
         let data = [analytic_data(256, c.spatial_dim)];
-        let model = c.init_seeded(&device, SEED, None).unwrap();
+        let model = BrdfModel::init_seeded(c, &device, SEED, None).unwrap();
         let (model, losses) = train(model, c, &data, 300, 3e-3, &device);
         assert!(losses[299] < losses[0], "{}: did not learn ({:?})", label(c), &losses[..3]);
         stress(&model, c, "after 300 steps", n, &device);

@@ -22,7 +22,7 @@
 mod common;
 
 use brdf_neural::device::Backend;
-use brdf_neural::{BrdfModel, ModelConfig, ModelKind};
+use brdf_neural::{BrdfBatch, BrdfModel, ModelConfig, ModelKind, SpatialTable};
 use burn::module::Module;
 use burn::tensor::{Device, Tensor, TensorData};
 use common::{OwnedSamples, parameters, rng, samples, small, train, values};
@@ -52,7 +52,7 @@ fn forward_and_gradients(
     s: &OwnedSamples,
     device: &Device,
 ) -> (Vec<f32>, Vec<Vec<f32>>) {
-    let out = model.forward(&c.batch(&s.view(), None, device).unwrap());
+    let out = model.forward(&BrdfBatch::new(c, &s.view(), None, device).unwrap());
     let f = values(out.f.clone());
     let grads = out.f.square().sum().backward();
     let g = burn::optim::GradientsParams::from_grads(grads, model);
@@ -75,7 +75,7 @@ fn every_model_kind_gives_the_cpus_values_and_gradients_on_the_gpu() {
     let gpu_device = gpu().training_device().expect("GPU backend built");
     for kind in ModelKind::ALL {
         let c = small(kind);
-        let model = c.init_seeded(&cpu, 11, None).unwrap();
+        let model = BrdfModel::init_seeded(&c, &cpu, 11, None).unwrap();
         let on_gpu = model.clone().fork(&gpu_device);
         assert_eq!(parameters(&on_gpu), parameters(&model), "{kind:?}: copied parameters");
         let s = samples(&mut rng(3), 257, c.spatial_dim);
@@ -113,7 +113,7 @@ fn loss_curves(
 ) -> (Vec<f32>, Vec<f32>, BrdfModel) {
     let cpu = brdf_neural::device::cpu_training();
     let gpu_device = gpu().training_device().unwrap();
-    let model = c.init_seeded(&cpu, init, None).unwrap();
+    let model = BrdfModel::init_seeded(c, &cpu, init, None).unwrap();
     let on_gpu = model.clone().fork(&gpu_device);
     let (_, l_cpu) = train(model, c, data, 30, 3e-3, &cpu);
     let _split = brdf_neural::split_k::scope(parts);
@@ -131,7 +131,7 @@ fn a_single_mlp_trains_along_the_same_loss_curve_on_the_gpu() {
     // The trained GPU model comes back to the CPU intact.
     let cpu = brdf_neural::device::cpu_training();
     let back = trained.fork(&cpu);
-    let f = values(back.forward(&c.batch(&data[0].0.view(), None, &cpu).unwrap()).f);
+    let f = values(back.forward(&BrdfBatch::new(&c, &data[0].0.view(), None, &cpu).unwrap()).f);
     assert!(f.iter().all(|v| v.is_finite()));
 }
 
@@ -169,11 +169,11 @@ fn spatial_rows_selected_on_the_gpu_are_the_gathered_rows() {
     let v: Vec<[f32; 3]> = (0..n).map(|i| dir(i, 1.3)).collect();
     for kind in [ModelKind::SingleMlp, ModelKind::Disney] {
         let c = ModelConfig { kind, spatial_dim: k, ..Default::default() };
-        let t = c.spatial_table(&table, &d).unwrap();
-        let a = c.batch_owned(gathered.clone(), &l, &v, None, &d).unwrap();
-        let b = c.batch_from_table(&t, &rows, &l, &v, None, &d).unwrap();
+        let t = SpatialTable::new(&c, &table, &d).unwrap();
+        let a = BrdfBatch::from_owned(&c, gathered.clone(), &l, &v, None, &d).unwrap();
+        let b = BrdfBatch::from_table(&c, &t, &rows, &l, &v, None, &d).unwrap();
         assert_eq!(values(a.spatial.clone()), values(b.spatial.clone()), "{kind:?}: rows");
-        let model = c.init(&d).unwrap();
+        let model = BrdfModel::init(&c, &d).unwrap();
         let (fa, fb) = (values(model.forward(&a).f), values(model.forward(&b).f));
         assert_close(&fb, &fa, 1e-6, &format!("{kind:?}: output"));
     }

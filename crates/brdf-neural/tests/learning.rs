@@ -7,7 +7,7 @@
 mod common;
 
 use brdf_analytic::{Brdf, TorranceSparrow, TorranceSparrowParams};
-use brdf_neural::{BrdfModel, ModelConfig, ModelKind, Reciprocity, device};
+use brdf_neural::{BrdfBatch, BrdfModel, ModelConfig, ModelKind, Reciprocity, device};
 use burn::tensor::{Tensor, TensorData};
 use common::{OwnedSamples, direction, parameters, rng, small, train, values};
 use rand::Rng;
@@ -40,7 +40,7 @@ fn target(s: &OwnedSamples) -> Vec<f32> {
 
 fn held_out_mse(model: &BrdfModel, c: &ModelConfig, s: &OwnedSamples, t: &[f32]) -> f32 {
     let device = device::cpu_training();
-    let out = model.forward(&c.batch(&s.view(), None, &device).unwrap());
+    let out = model.forward(&BrdfBatch::new(c, &s.view(), None, &device).unwrap());
     let t = Tensor::<2>::from_data(TensorData::new(t.to_vec(), [s.l.len(), 3]), &device);
     values((out.f - t).square().mean())[0]
 }
@@ -58,7 +58,7 @@ fn fit(c: &ModelConfig, steps: usize, lr: f64) -> (f32, f32) {
         .collect();
     let test = samples(&mut r, 1024);
     let test_t = target(&test);
-    let model = c.init_seeded(&device, 5, None).unwrap();
+    let model = BrdfModel::init_seeded(c, &device, 5, None).unwrap();
     let before = held_out_mse(&model, c, &test, &test_t);
     let (model, losses) = train(model, c, &data, steps, lr, &device);
     assert!(losses.iter().all(|l| l.is_finite()));
@@ -105,7 +105,7 @@ fn seeded_initial_weights_do_not_depend_on_other_threads() {
     let kinds = [ModelKind::SingleMlp, ModelKind::Disney, ModelKind::AdditiveSharedEnhanced];
     let alone: Vec<_> = kinds
         .iter()
-        .map(|&k| parameters(&small(k).init_seeded(&device, 7, None).unwrap()))
+        .map(|&k| parameters(&BrdfModel::init_seeded(&small(k), &device, 7, None).unwrap()))
         .collect();
     std::thread::scope(|scope| {
         for (i, (&kind, want)) in kinds.iter().zip(&alone).enumerate() {
@@ -114,8 +114,9 @@ fn seeded_initial_weights_do_not_depend_on_other_threads() {
                 let c = small(kind);
                 for round in 0..40 {
                     // Unseeded builds draw from the same generator in between.
-                    let _other = small(kinds[(i + 1) % kinds.len()]).init(&device).unwrap();
-                    let got = parameters(&c.init_seeded(&device, 7, None).unwrap());
+                    let _other =
+                        BrdfModel::init(&small(kinds[(i + 1) % kinds.len()]), &device).unwrap();
+                    let got = parameters(&BrdfModel::init_seeded(&c, &device, 7, None).unwrap());
                     assert!(
                         got == *want,
                         "{kind:?}: other threads changed round {round}'s weights"

@@ -4,7 +4,7 @@
 
 mod common;
 
-use brdf_neural::{ModelKind, Reciprocity, device};
+use brdf_neural::{BrdfBatch, BrdfModel, ModelKind, Reciprocity, device};
 use common::{rng, samples, small, values};
 
 const NEURAL: [ModelKind; 5] = [
@@ -29,10 +29,10 @@ fn mapping_gives_bit_identical_outputs_under_swap() {
             c.nol = nol;
             c.albedo_clamp = nerfactor;
             c.scalar_specular = nerfactor;
-            let model = c.init(&device).unwrap();
+            let model = BrdfModel::init(&c, &device).unwrap();
             let s = samples(&mut r, 256, c.spatial_dim);
-            let a = model.forward(&c.batch(&s.view(), None, &device).unwrap());
-            let b = model.forward(&c.batch(&s.swapped().view(), None, &device).unwrap());
+            let a = model.forward(&BrdfBatch::new(&c, &s.view(), None, &device).unwrap());
+            let b = model.forward(&BrdfBatch::new(&c, &s.swapped().view(), None, &device).unwrap());
             let (fa, fb) = (values(a.f), values(b.f));
             assert!(
                 fa.iter().zip(&fb).all(|(x, y)| x.to_bits() == y.to_bits()),
@@ -51,10 +51,12 @@ fn without_mapping_outputs_change_under_swap() {
     let mut r = rng(8);
     for kind in NEURAL {
         let c = small(kind);
-        let model = c.init(&device).unwrap();
+        let model = BrdfModel::init(&c, &device).unwrap();
         let s = samples(&mut r, 64, c.spatial_dim);
-        let a = values(model.forward(&c.batch(&s.view(), None, &device).unwrap()).f);
-        let b = values(model.forward(&c.batch(&s.swapped().view(), None, &device).unwrap()).f);
+        let a = values(model.forward(&BrdfBatch::new(&c, &s.view(), None, &device).unwrap()).f);
+        let b = values(
+            model.forward(&BrdfBatch::new(&c, &s.swapped().view(), None, &device).unwrap()).f,
+        );
         assert!(a.iter().zip(&b).any(|(x, y)| x != y), "{kind:?} is reciprocal by accident");
     }
 }
@@ -64,13 +66,14 @@ fn random_swap_mask_swaps_the_network_input_only() {
     let device = device::cpu();
     let mut c = small(ModelKind::SingleMlp);
     c.angles.reciprocity = Reciprocity::RandomSwap;
-    let model = c.init(&device).unwrap();
+    let model = BrdfModel::init(&c, &device).unwrap();
     let s = samples(&mut rng(9), 100, c.spatial_dim);
     let mask = c.angles.swap_mask(100, &mut rng(10));
     let swapped = mask.iter().filter(|&&m| m).count();
     assert!((30..=70).contains(&swapped), "{swapped} of 100 swapped at p = 0.5");
     let all = vec![true; 100];
-    let a = values(model.forward(&c.batch(&s.view(), Some(&all), &device).unwrap()).f);
-    let b = values(model.forward(&c.batch(&s.swapped().view(), None, &device).unwrap()).f);
+    let a = values(model.forward(&BrdfBatch::new(&c, &s.view(), Some(&all), &device).unwrap()).f);
+    let b =
+        values(model.forward(&BrdfBatch::new(&c, &s.swapped().view(), None, &device).unwrap()).f);
     assert_eq!(a, b);
 }

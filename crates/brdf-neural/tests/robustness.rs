@@ -5,7 +5,8 @@
 mod common;
 
 use brdf_neural::{
-    AngleParametrization, BrdfParams, ModelConfig, ModelKind, Reciprocity, Samples, device,
+    AngleParametrization, BrdfBatch, BrdfModel, BrdfParams, ModelConfig, ModelKind, Reciprocity,
+    Samples, device,
 };
 use common::{direction, rng, small, values};
 
@@ -59,9 +60,10 @@ fn variants() -> Vec<ModelConfig> {
 fn outputs_are_finite_and_non_negative_for_extreme_inputs() {
     let device = device::cpu();
     for c in variants() {
-        let model = c.init(&device).unwrap();
+        let model = BrdfModel::init(&c, &device).unwrap();
         let (spatial, l, v) = extreme(c.spatial_dim);
-        let batch = c.batch(&Samples { spatial: &spatial, l: &l, v: &v }, None, &device).unwrap();
+        let batch = BrdfBatch::new(&c, &Samples { spatial: &spatial, l: &l, v: &v }, None, &device)
+            .unwrap();
         let out = model.forward(&batch);
         for (name, t) in [("f", Some(out.f)), ("diffuse", out.diffuse), ("specular", out.specular)]
         {
@@ -90,10 +92,11 @@ fn parametric_parameters_stay_in_their_ranges() {
     let device = device::cpu();
     for kind in [ModelKind::Rp, ModelKind::Ts, ModelKind::Disney, ModelKind::Fmbrdf] {
         let c = small(kind);
-        let model = c.init(&device).unwrap();
+        let model = BrdfModel::init(&c, &device).unwrap();
         let brdf_neural::BrdfModel::Parametric(p) = &model else { panic!("parametric") };
         let (spatial, l, v) = extreme(c.spatial_dim);
-        let batch = c.batch(&Samples { spatial: &spatial, l: &l, v: &v }, None, &device).unwrap();
+        let batch = BrdfBatch::new(&c, &Samples { spatial: &spatial, l: &l, v: &v }, None, &device)
+            .unwrap();
         match p.params(batch.spatial.clone()) {
             BrdfParams::RealisticPhong(q) => {
                 assert!(in_range(q.kd.clone(), 0.0, 1.0) && in_range(q.ks.clone(), 0.0, 1.0));

@@ -7,11 +7,11 @@
 //! are removed only after the new one is complete, so a crash or a non-finite loss always
 //! leaves the last good one.
 
-use crate::run_dir::{CurveRow, RunDir};
 use crate::{Error, Result};
 use brdf_neural::BrdfModel;
 use burn::module::Module;
 use burn::optim::ModuleOptimizer;
+use run_format::run_dir::{CurveRow, RunDir};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -30,16 +30,16 @@ pub struct CheckpointState {
     pub seconds: f64,
     /// The plateau rule's state.
     #[serde(default)]
-    pub plateau: crate::plateau::Plateau,
+    pub plateau: run_format::plateau::Plateau,
     /// Snapshots kept so far.
     #[serde(default)]
-    pub snapshots: Vec<crate::run_dir::Snapshot>,
+    pub snapshots: Vec<run_format::run_dir::Snapshot>,
     /// Set once training has stopped early (the checkpoint of the last step).
     #[serde(default)]
-    pub stopped: Option<crate::plateau::StopReason>,
+    pub stopped: Option<run_format::plateau::StopReason>,
     /// Seconds per phase of the step so far.
     #[serde(default)]
-    pub phases: crate::phases::StepPhases,
+    pub phases: run_format::phases::StepPhases,
 }
 
 /// Writes a checkpoint atomically and removes the older ones; returns its folder.

@@ -1,10 +1,9 @@
 //! Robustness of the configuration readers (issue 19): corrupted copies of run configurations
-//! and of every shipped sweep profile (truncated, digits and separators scattered, keys and
+//! (truncated, digits and separators scattered, keys and
 //! values spliced, noise) give an error naming the file, never a panic; and a probe file that
 //! is not one is refused by its checksum.
 
-use crate::config::RunConfig;
-use crate::sweep::SweepProfile;
+use run_format::config::RunConfig;
 use std::path::Path;
 use test_support::corrupt::fuzz_loader;
 
@@ -21,24 +20,6 @@ fn corrupted_run_configs_give_errors_not_panics() {
             && let Err(e) = RunConfig::from_toml(text, Path::new("fuzz.toml"))
         {
             assert!(e.to_string().contains("fuzz.toml"), "{e}");
-        }
-    });
-}
-
-#[test]
-fn corrupted_sweep_profiles_give_errors_not_panics() {
-    let seeds: Vec<Vec<u8>> = ["default", "quick", "smoke", "runtime", "full"]
-        .iter()
-        .map(|name| {
-            let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles");
-            std::fs::read(dir.join(format!("{name}.toml"))).unwrap()
-        })
-        .collect();
-    fuzz_loader("sweep-profile", &seeds, 4000, |b| {
-        if let Ok(text) = std::str::from_utf8(b)
-            && let Err(e) = SweepProfile::parse(text, "fuzz-profile.toml")
-        {
-            assert!(e.to_string().contains("fuzz-profile.toml"), "{e}");
         }
     });
 }

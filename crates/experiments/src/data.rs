@@ -6,7 +6,6 @@
 //! shadowed and back-facing ones: they carry no information about the BRDF); samples whose
 //! cosine is not positive are dropped here as well.
 
-use crate::config::{FeatureConfig, SpatialKind};
 use crate::loss::srgb_oetf;
 use crate::{Error, Result};
 use angles::Frame;
@@ -14,6 +13,7 @@ use mesh_encoding::{EigenSettings, LboEncoding, cached_eigenpairs};
 use rand::SeedableRng;
 use rand::rngs::StdRng;
 use rand::seq::SliceRandom;
+use run_format::config::{FeatureConfig, SpatialKind};
 use scene::Split;
 use scene::shading::light_weight;
 use scene::{SampleSet, SceneDataset};

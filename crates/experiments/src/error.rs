@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-/// Errors of training and evaluation.
+/// Errors of training, evaluation, export and sweeps.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// A configuration file could not be parsed (unknown key, wrong type); serde's message
@@ -140,5 +140,19 @@ pub type Result<T> = std::result::Result<T, Error>;
 impl From<stdx::fs::Error> for Error {
     fn from(e: stdx::fs::Error) -> Self {
         Self::Io { path: e.path, source: e.source }
+    }
+}
+
+impl From<run_format::Error> for Error {
+    /// The same variant: a run's files fail the same way whichever stage reads them.
+    fn from(e: run_format::Error) -> Self {
+        match e {
+            run_format::Error::ConfigParse { path, message } => {
+                Error::ConfigParse { path, message }
+            }
+            run_format::Error::Config { key, message } => Error::Config { key, message },
+            run_format::Error::Io { path, source } => Error::Io { path, source },
+            run_format::Error::Format { path, message } => Error::Format { path, message },
+        }
     }
 }

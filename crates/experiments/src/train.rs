@@ -6,7 +6,7 @@
 //! regularisers of the enhanced models; with `reciprocity = "random_swap"` the network input
 //! swaps l and v per sample. A fraction of each training view's lights is held out: their
 //! validation loss drives the plateau schedule, which decays the rate and stops a converged
-//! run ([`crate::train_config`], [`crate::plateau`]). The loop itself is in
+//! run ([`run_format::train_config`], [`run_format::plateau`]). The loop itself is in
 //! [`crate::trainer`].
 //!
 //! Checkpoints every `checkpoint_every` steps hold the weights, Adam's state, the curve and
@@ -17,10 +17,8 @@
 //! checkpoint that resumes it.
 
 use crate::checkpoint::{self, CheckpointState};
-use crate::config::RunConfig;
 use crate::data::{TrainingData, spatial_features, split_validation, validation_pairs};
-use crate::run_dir::{RunDir, RunMetrics};
-use crate::train_config::OutputInit;
+use crate::eval::FittedRun;
 use crate::trainer::{
     GPU_LOSS_READS, Loop, LoopEnd, device_records, device_table, gamma_mse, save_weights,
 };
@@ -31,6 +29,9 @@ use burn::module::Module;
 use burn::optim::AdamConfig;
 use burn::tensor::Device;
 use indicatif::ProgressBar;
+use run_format::config::RunConfig;
+use run_format::run_dir::{RunDir, RunMetrics};
+use run_format::train_config::OutputInit;
 use scene::SceneDataset;
 use scene::Split;
 use std::path::{Path, PathBuf};
@@ -90,6 +91,14 @@ pub struct Trained {
     pub device: Device,
     /// The scene it was trained on, opened and verified once.
     pub scene: SceneDataset,
+}
+
+impl Trained {
+    /// The run that was just trained, opened for evaluation (no weights or scene read back
+    /// from disk).
+    pub fn into_fitted(self, config: RunConfig, cache: PathBuf) -> FittedRun {
+        FittedRun { config, device: self.device, model: self.model, dataset: self.scene, cache }
+    }
 }
 
 /// The records a run trains and validates on.
@@ -224,7 +233,7 @@ pub fn fit_and_keep(
 
     let device = options.backend.training_device()?;
     let initial_brdf = (t.output_init == OutputInit::Data).then(|| data.mean_brdf());
-    let mut model = config.model.init_seeded(&device, config.seed, initial_brdf)?;
+    let mut model = BrdfModel::init_seeded(&config.model, &device, config.seed, initial_brdf)?;
     let mut optim = AdamConfig::new().with_epsilon(t.adam_epsilon as f32).init();
     let mut state = CheckpointState::default();
     let last_checkpoint = checkpoint::latest(&dir)?;
@@ -376,17 +385,4 @@ fn run_metrics(
         phases: Some(state.phases.clone()),
         backend: None,
     }
-}
-
-/// Loads the final weights of a finished run.
-pub fn load_weights(config: &RunConfig, run: &RunDir, device: &Device) -> Result<BrdfModel> {
-    let path = run.weights();
-    if !path.is_file() {
-        return Err(Error::format(&path, "no final weights: the run has not finished (run fit)"));
-    }
-    config
-        .model
-        .init(device)?
-        .try_load_file(&path)
-        .map_err(|e| Error::format(&path, format!("cannot load weights: {e:?}")))
 }

@@ -7,14 +7,10 @@
 //! run repeats an uninterrupted one exactly.
 
 use crate::checkpoint::{self, CheckpointState};
-use crate::config::RunConfig;
 use crate::data::TrainingData;
 use crate::diagnose::{all_finite, diagnose, worst_input};
 use crate::loss::{LossWeights, loss, srgb_oetf};
 use crate::loss_window::{FreshLeaves, LossWindow, StepLoss, WindowStart};
-use crate::phases::{Phase, PhaseTimer};
-use crate::plateau::{Decision, StopReason};
-use crate::run_dir::{CurveRow, RunDir, Snapshot, write_curve};
 use crate::{Error, Result};
 use brdf_neural::{BrdfBatch, BrdfModel, Reciprocity, RecordTable, Samples, SpatialTable};
 use burn::module::Module;
@@ -23,6 +19,10 @@ use burn::tensor::{Device, Tensor, TensorData};
 use indicatif::ProgressBar;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
+use run_format::config::RunConfig;
+use run_format::phases::{Phase, PhaseTimer};
+use run_format::plateau::{Decision, StopReason};
+use run_format::run_dir::{CurveRow, RunDir, Snapshot, write_curve};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -310,8 +310,13 @@ impl Loop<'_> {
             timer.charge(Phase::Gather);
             let mask = swap.then(|| c.angles.swap_mask(bs, rng));
             let index = records.table.index(&rows, mask.as_deref(), &self.device)?;
-            let batch =
-                c.batch_from_records(&records.table, self.spatial.as_ref(), &index, &self.device)?;
+            let batch = BrdfBatch::from_records(
+                c,
+                &records.table,
+                self.spatial.as_ref(),
+                &index,
+                &self.device,
+            )?;
             let weight = records.weight.clone().select(0, index.rows.clone());
             let target = records.target.clone().select(0, index.rows);
             timer.charge(Phase::Encode);
@@ -327,9 +332,9 @@ impl Loop<'_> {
         let batch = match &self.spatial {
             Some(table) => {
                 let points = self.data.points_of(indices);
-                c.batch_from_table(table, &points, l, v, mask, &self.device)?
+                BrdfBatch::from_table(c, table, &points, l, v, mask, &self.device)?
             }
-            None => c.batch_owned(cpu.spatial, l, v, mask, &self.device)?,
+            None => BrdfBatch::from_owned(c, cpu.spatial, l, v, mask, &self.device)?,
         };
         let weight = tensor(cpu.weight, bs, &self.device);
         let target = tensor(cpu.target_gamma, bs, &self.device);
@@ -429,14 +434,14 @@ pub fn device_records(
     device: &Device,
 ) -> Result<Option<DeviceRecords>> {
     let n = data.len();
-    let bytes = model.record_table_bytes(n) + n * 6 * 4;
+    let bytes = RecordTable::bytes(model, n) + n * 6 * 4;
     if !on_device
         || (model.spatial_dim > 0 && spatial.is_none())
         || bytes > DEVICE_RECORDS_MAX_BYTES
     {
         return Ok(None);
     }
-    let table = model.record_table(&data.l, &data.v, &data.point, device)?;
+    let table = RecordTable::new(model, &data.l, &data.v, &data.point, device)?;
     let weight = tensor(data.weight.as_flattened().to_vec(), n, device);
     let target = tensor(data.observed_gamma.as_flattened().to_vec(), n, device);
     Ok(Some(DeviceRecords { table, weight, target }))
@@ -459,7 +464,7 @@ pub fn device_table(
     if !on_device || data.spatial_dim == 0 || bytes > DEVICE_TABLE_MAX_BYTES {
         return Ok(None);
     }
-    Ok(Some(model.spatial_table(&data.spatial, device)?))
+    Ok(Some(SpatialTable::new(model, &data.spatial, device)?))
 }
 
 /// The gamma-MSE of `model` on the records `val` (no regularisers), computed in inference

@@ -13,9 +13,15 @@ use scene::{MaterialSpec, SceneConfig, SceneSettings, Split};
 
 use test_support::TempDir;
 
+/// The Spot mesh the binaries embed (`embedded:spot`).
+fn spot_mesh() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data-manifests/embedded/spot/spot.obj")
+}
+
 fn smoke_scene(dir: &std::path::Path) -> SceneDataset {
     let config = SceneConfig {
-        mesh: experiments::sweep::profile::resolve_mesh("embedded:spot", dir).unwrap(),
+        mesh: spot_mesh(),
         material: MaterialSpec::Merl { name: "blue-acrylic".into() },
         seed: 1,
         settings: SceneSettings::with_counts(32, 4, 12),

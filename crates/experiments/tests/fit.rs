@@ -6,8 +6,8 @@
 
 use burn::module::{ModuleMapper, Param};
 use burn::tensor::Tensor;
-use experiments::run_dir::RunDir;
 use experiments::{Error, FitOptions, FitOutcome, RunConfig, fit};
+use run_format::RunDir;
 use scene::{MaterialSpec, SceneConfig, SceneSettings};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -164,7 +164,10 @@ fn models_fit_the_scene_and_eval_scores_them() {
         let c = config(kind, 300, eval).model;
         let device = brdf_neural::device::cpu_training();
         let weights = RunDir::new(&run).weights();
-        let model = burn::module::Module::load_file(c.init(&device).unwrap(), &weights);
+        let model = burn::module::Module::load_file(
+            brdf_neural::BrdfModel::init(&c, &device).unwrap(),
+            &weights,
+        );
         let n = 1 << 14;
         let (l, v) = test_support::adversarial::direction_pairs(9, 0, n);
         let spatial = test_support::adversarial::spatial_rows(9, 0, n, c.spatial_dim);
@@ -312,7 +315,7 @@ fn a_converged_run_stops_on_its_plateau_and_says_so() {
     c.train.lr_final = 5e-5;
     let out = fit(&c, &run, FitOptions::default()).unwrap();
     let FitOutcome::Finished { metrics, .. } = out else { panic!("{out:?}") };
-    assert_eq!(metrics.stop_reason, Some(experiments::plateau::StopReason::Plateau));
+    assert_eq!(metrics.stop_reason, Some(run_format::plateau::StopReason::Plateau));
     assert!(metrics.steps < 5000, "{metrics:?}");
     assert_eq!(metrics.lr_decays, 2, "{metrics:?}");
     assert!(metrics.val_records > 0 && metrics.best_val_loss.is_some_and(|v| v > 0.0));
@@ -320,11 +323,11 @@ fn a_converged_run_stops_on_its_plateau_and_says_so() {
     assert!(metrics.train_records > 2 * metrics.val_records, "{metrics:?}");
     // The same budget on a decaying schedule runs to the end, reported as such.
     let mut e = c.clone();
-    e.train.schedule = experiments::config::Schedule::Exponential;
+    e.train.schedule = run_format::config::Schedule::Exponential;
     e.train.iterations = 50;
     let out = fit(&e, &dir.0.join("exp"), FitOptions::default()).unwrap();
     let FitOutcome::Finished { metrics, .. } = out else { panic!("{out:?}") };
-    assert_eq!(metrics.stop_reason, Some(experiments::plateau::StopReason::Budget));
+    assert_eq!(metrics.stop_reason, Some(run_format::plateau::StopReason::Budget));
     assert_eq!(metrics.steps, 50);
 }
 
@@ -447,9 +450,9 @@ fn lbo_features_are_interpolated_and_cached() {
 
 #[test]
 fn fits_export_to_renderers() {
-    use experiments::config::SpatialKind;
     use experiments::eval::FittedRun;
     use experiments::export::{ExportedMaterial, Format, export, gltf};
+    use run_format::config::SpatialKind;
     let dir = TempDir::new("export");
     for kind in ["ts", "disney"] {
         // A spatially uniform fit: the exported material is the fitted BRDF.

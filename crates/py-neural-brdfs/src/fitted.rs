@@ -78,7 +78,7 @@ impl Run {
 
     /// The run's configuration as TOML text.
     fn config_toml(&self) -> PyResult<String> {
-        self.run.config.to_toml().map_err(run_error)
+        self.run.config.to_toml().map_err(|e| run_error(e.into()))
     }
 
     /// The lit sample records of the run's scene for a split (as `Scene.samples`).
@@ -193,10 +193,10 @@ impl Run {
     /// into the run directory; for runs trained before it did). Returns the two paths.
     fn save_portable(&self, py: Python<'_>, out: PathBuf) -> PyResult<Vec<PathBuf>> {
         let r = &self.run;
-        let weights = experiments::run_dir::RunDir::new(&self.dir).weights();
+        let weights = run_format::RunDir::new(&self.dir).weights();
         let paths = py
             .detach(|| {
-                let out = experiments::run_dir::RunDir::new(&out);
+                let out = run_format::RunDir::new(&out);
                 experiments::export::portable::write(
                     &out, &weights, &r.config, &r.dataset, &r.cache,
                 )

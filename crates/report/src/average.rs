@@ -4,8 +4,8 @@
 
 use super::record::{Dataset, MetricKind, RunOptions, RunRecord};
 use super::table::Cell;
-use brdf_neural::ModelKind;
 use metrics::aggregate::{PerObjectMean, Score};
+use model_spec::ModelKind;
 use std::collections::BTreeMap;
 
 /// Each run's last evaluation: of the records sharing model, options, data set and object,

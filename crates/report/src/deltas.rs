@@ -15,7 +15,7 @@ use super::average::{datasets, final_records, paired_delta};
 use super::record::{RunOptions, RunRecord};
 use super::result_tables::{caption, image_metrics};
 use super::table::{Column, ColumnGroup, Marking, Row, Table};
-use brdf_neural::{AngleParametrization, ModelKind, Reciprocity};
+use model_spec::{AngleParametrization, ModelKind, Reciprocity};
 
 /// One setting compared with the baseline.
 #[derive(Clone, Debug, PartialEq)]

@@ -12,8 +12,8 @@ use super::grid::{GridCell, GridRow, ImageGrid, RgbImage};
 use super::plot::{LinePlot, Series};
 use super::record::{Dataset, MetricKind, RunOptions, RunRecord};
 use super::table::Cell;
-use brdf_neural::ModelKind;
 use metrics::aggregate::Score;
+use model_spec::ModelKind;
 
 /// `metric` against training time on `dataset`, one curve per model (default options).
 ///

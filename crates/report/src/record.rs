@@ -3,8 +3,8 @@
 //! The lead collects these from run directories (`metrics.json`, the energy and reciprocity
 //! analyses); everything in [this crate](crate) is a pure function of a slice of them.
 
-use brdf_neural::{AngleParametrization, ModelConfig, ModelKind, Reciprocity};
 use metrics::aggregate::{Score, TableScale};
+use model_spec::{AngleParametrization, ModelConfig, ModelKind, Reciprocity};
 use std::collections::BTreeMap;
 use std::fmt;
 

@@ -9,8 +9,8 @@
 use super::average::{average, datasets, final_records, objects, per_object};
 use super::record::{Dataset, MetricKind, RunOptions, RunRecord};
 use super::table::{Cell, Column, ColumnGroup, Marking, Row, Table};
-use brdf_neural::{ModelKind, Reciprocity};
 use metrics::aggregate::{PerObjectMean, Score};
+use model_spec::{ModelKind, Reciprocity};
 use std::collections::BTreeMap;
 
 /// How the image metrics of a table were computed. Every run is scored both ways; each

@@ -11,8 +11,8 @@ use super::average::objects;
 use super::record::{Dataset, Direction, MetricKind, RunOptions, RunRecord};
 use super::result_tables::caption;
 use super::table::{Cell, Column, ColumnGroup, Marking, Row, Table};
-use brdf_neural::ModelKind;
 use metrics::aggregate::{PerObjectMean, Score};
+use model_spec::ModelKind;
 
 /// One model's curve on one object: (steps, seconds, PSNR, RMSE∛), in step order.
 type Curve = Vec<(u64, f64, f64, Option<f64>)>;

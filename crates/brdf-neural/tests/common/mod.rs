@@ -3,7 +3,7 @@
 
 #![allow(dead_code)]
 
-use brdf_neural::{BrdfModel, ModelConfig, Samples};
+use brdf_neural::{BrdfBatch, BrdfModel, ModelConfig, Samples};
 use burn::module::{Module, ModuleVisitor, Param};
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::{Device, Tensor};
@@ -87,7 +87,7 @@ pub fn train(
     let batches: Vec<_> = data
         .iter()
         .map(|(s, t)| {
-            let b = config.batch(&s.view(), None, device).unwrap();
+            let b = BrdfBatch::new(config, &s.view(), None, device).unwrap();
             let target = Tensor::<2>::from_data(
                 burn::tensor::TensorData::new(t.clone(), [s.l.len(), 3]),
                 device,

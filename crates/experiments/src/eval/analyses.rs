@@ -2,29 +2,10 @@
 //! conservation (directional albedo of random (x, l) pairs) and the reciprocity RMSE.
 
 use super::predict::ModelBrdf;
-use super::settings::EvalSettings;
 use crate::Result;
 use metrics::energy::{EnergyConfig, EnergyPair, energy_conservation, sample_pairs};
-use serde::{Deserialize, Serialize};
-
-/// The energy-conservation result of a run.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct EnergySummary {
-    /// `fast` or `paper`.
-    pub estimator: String,
-    /// (x, l) pairs analysed.
-    pub pairs: usize,
-    /// Percentage of pairs with some channel's albedo above 1.
-    pub percent_above_one: f64,
-    /// Median over violating pairs of their largest channel (`None`: no violation).
-    pub median_above_one: Option<f64>,
-    /// Mean standard error of the per-pair estimates (all channels).
-    pub mean_std_error: f64,
-    /// BRDF evaluations spent.
-    pub evaluations: u64,
-    /// Wall-clock seconds.
-    pub seconds: f64,
-}
+use run_format::EnergySummary;
+use run_format::eval_config::EvalSettings;
 
 /// Runs the configured energy analysis on `pairs` random test records (`None` when off).
 pub fn energy(

@@ -1,17 +1,28 @@
 //! A finished run opened for analysis: its configuration, fitted model and scene, shared by
 //! `eval`, `energy` and `export-merl`.
 
-use crate::config::RunConfig;
 use crate::data::{TrainingData, spatial_features};
-use crate::run_dir::RunDir;
-use crate::train::load_weights;
 use crate::{Error, Result};
 use brdf_neural::BrdfModel;
 use brdf_neural::device::Backend;
 use burn::tensor::Device;
+use run_format::config::RunConfig;
+use run_format::run_dir::RunDir;
 use scene::Split;
 use scene::{SampleSet, SceneDataset};
 use std::path::{Path, PathBuf};
+
+/// Loads the final weights of a finished run.
+pub fn load_weights(config: &RunConfig, run: &RunDir, device: &Device) -> Result<BrdfModel> {
+    use burn::module::Module;
+    let path = run.weights();
+    if !path.is_file() {
+        return Err(Error::format(&path, "no final weights: the run has not finished (run fit)"));
+    }
+    BrdfModel::init(&config.model, device)?
+        .try_load_file(&path)
+        .map_err(|e| Error::format(&path, format!("cannot load weights: {e:?}")))
+}
 
 /// A finished run with its model loaded and its scene opened.
 pub struct FittedRun {
@@ -57,19 +68,10 @@ impl FittedRun {
         Ok(Self { config, device, model, dataset, cache })
     }
 
-    /// The run that was just trained in this process, from what training hands over (no
-    /// weights or scene read back from disk).
-    pub fn from_trained(config: RunConfig, trained: crate::train::Trained, cache: PathBuf) -> Self {
-        let crate::train::Trained { model, device, scene } = trained;
-        Self { config, device, model, dataset: scene, cache }
-    }
-
     /// Another weight file of the same configuration (a snapshot) on the run's device.
     pub fn load_weights_file(&self, path: &Path) -> Result<BrdfModel> {
         use burn::module::Module;
-        self.config
-            .model
-            .init(&self.device)?
+        BrdfModel::init(&self.config.model, &self.device)?
             .try_load_file(path)
             .map_err(|e| Error::format(path, format!("cannot load weights: {e:?}")))
     }

@@ -48,50 +48,13 @@ use indicatif::ProgressBar;
 use metrics::Image;
 use metrics::lpips::Lpips;
 use rayon::prelude::*;
+use run_format::ImageMetrics;
 use scene::Split;
 use scene::images::{exr_rgb_bytes, png_srgb_bytes};
 use scene::shading::shade;
 use scene::{SampleSet, SceneDataset};
-use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-
-/// Mean image metrics over the test images, raw (not table-scaled).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct ImageMetrics {
-    /// Mean PSNR (dB, sRGB clamped, object mask); +inf for identical images.
-    #[serde(with = "super::serde_inf")]
-    pub psnr: f64,
-    /// Mean DSSIM.
-    pub dssim: f64,
-    /// Mean HDR-FLIP.
-    pub flip: f64,
-    /// Mean LPIPS, when its weights were present.
-    #[serde(default)]
-    pub lpips: Option<f64>,
-}
-
-impl ImageMetrics {
-    fn add(&mut self, o: &ImageMetrics) {
-        self.psnr += o.psnr;
-        self.dssim += o.dssim;
-        self.flip += o.flip;
-        self.lpips = match (self.lpips, o.lpips) {
-            (Some(a), Some(b)) => Some(a + b),
-            (None, Some(b)) => Some(b),
-            (a, None) => a,
-        };
-    }
-
-    fn divided(mut self, n: usize) -> Self {
-        let n = n.max(1) as f64;
-        self.psnr /= n;
-        self.dssim /= n;
-        self.flip /= n;
-        self.lpips = self.lpips.map(|l| l / n);
-        self
-    }
-}
 
 /// The mean metrics of a run's test images.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -125,7 +88,7 @@ fn write_exr_rgb(path: &Path, width: usize, height: usize, rgb: &[[f32; 3]]) -> 
 }
 
 /// Writes a linear RGB image as an 8-bit sRGB PNG atomically.
-pub(crate) fn write_png_srgb(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<()> {
+pub fn write_png_srgb(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<()> {
     Ok(stdx::fs::write_atomic(path, &png_srgb_bytes(path, width, height, rgb)?)?)
 }
 
@@ -480,7 +443,7 @@ impl OutputDirs {
         if !write {
             return Ok(None);
         }
-        let run = crate::run_dir::RunDir::new(run);
+        let run = run_format::run_dir::RunDir::new(run);
         let d = OutputDirs { renders: run.renders(), flips: run.flip(), albedo: run.albedo() };
         for dir in [&d.renders, &d.flips, &d.albedo] {
             std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;

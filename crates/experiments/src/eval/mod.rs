@@ -21,95 +21,22 @@
 pub mod analyses;
 pub mod fitted;
 pub mod images;
-pub mod metric_settings;
 pub mod predict;
 pub mod probe;
-pub(crate) mod serde_inf;
-pub mod settings;
 
-pub use analyses::EnergySummary;
 pub use fitted::FittedRun;
-pub use images::ImageMetrics;
 pub use predict::{ModelBrdf, Prediction, predict};
-pub use settings::{EnergyEstimator, EvalConfig, EvalSettings};
 
 use crate::Result;
 use crate::data::TrainingData;
-use crate::phases::EvalPhases;
-use crate::run_dir::{RunDir, RunMetrics, Snapshot};
 use metrics::rmse::{CubeRootRmse, RmseConfig};
+use run_format::metric_settings;
+use run_format::phases::EvalPhases;
+use run_format::run_dir::{RunDir, RunMetrics, Snapshot};
+use run_format::{CurvePoint, EnergyEstimator, EnergySummary, ImageMetrics, TestMetrics};
 use scene::SampleSet;
-use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::time::Instant;
-
-/// One point of a run's run-time curve: the test scores of a weight snapshot.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct CurvePoint {
-    /// Training steps of the snapshot.
-    pub step: u64,
-    /// Wall time of the run at that step, seconds.
-    pub seconds: f64,
-    /// Mean test PSNR (dB) against the observed images.
-    pub psnr: f64,
-    /// Cube-root RMSE of the BRDF (absent without ground truth).
-    #[serde(default)]
-    pub rmse_cbrt: Option<f64>,
-}
-
-/// Test metrics of a run (spec 7), raw values (not table-scaled).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct TestMetrics {
-    /// Mean PSNR over the test images (dB, sRGB clamped, object mask): our protocol, as are
-    /// every score up to `lpips` and `settings`.
-    pub psnr: f64,
-    /// Mean DSSIM over the test images.
-    pub dssim: f64,
-    /// Mean HDR-FLIP over the test images.
-    pub flip: f64,
-    /// The model against the noise-free test renders (semi-synthetic scenes only).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub clean: Option<ImageMetrics>,
-    /// The noise ceiling: the noise-free test renders scored against the observed ones, the
-    /// best any model can score (semi-synthetic scenes only).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub ceiling: Option<ImageMetrics>,
-    /// The paper's protocol: the whole frame against the noise-free renders, with its
-    /// settings (absent in runs evaluated before it was added; the sweep re-evaluates them).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub paper: Option<metric_settings::PaperProtocol>,
-    /// Mean LPIPS over the test images (absent without weights).
-    #[serde(default)]
-    pub lpips: Option<f64>,
-    /// Why LPIPS is absent ("weights missing").
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub lpips_unavailable: Option<String>,
-    /// Cube-root RMSE of the BRDF on the test samples (absent without ground truth).
-    #[serde(default)]
-    pub rmse_cbrt: Option<f64>,
-    /// Samples that entered the RMSE.
-    pub rmse_samples: usize,
-    /// Test images evaluated.
-    pub images: usize,
-    /// RMSE between f(x, l, v) and f(x, v, l) over test records.
-    #[serde(default)]
-    pub reciprocity_rmse: Option<f64>,
-    /// Energy conservation.
-    #[serde(default)]
-    pub energy: Option<EnergySummary>,
-    /// Test scores of the weight snapshots, in step order (runs with `train.snapshots`).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub curve: Vec<CurvePoint>,
-    /// The exact settings of every score (absent in runs evaluated before they were recorded).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub settings: Option<metric_settings::MetricSettings>,
-    /// Wall-clock seconds of the whole evaluation.
-    #[serde(default)]
-    pub seconds: f64,
-    /// Where those seconds went (absent in older runs).
-    #[serde(default)]
-    pub phases: EvalPhases,
-}
 
 /// Only the energy analysis of a finished run, with `estimator` and `pairs` overriding the
 /// run's `[eval]` settings (for comparing the two estimators on one model).
@@ -161,8 +88,7 @@ struct CeilingCache(std::path::PathBuf);
 
 impl CeilingCache {
     fn new(cache: &Path, scene: &scene::SceneDataset, lpips: bool) -> Self {
-        let key =
-            format!("{}\n{lpips}\n{}", scene.manifest.checksum, crate::sweep::plan::CODE_VERSION);
+        let key = format!("{}\n{lpips}\n{}", scene.manifest.checksum, run_format::CODE_VERSION);
         let hash = xxhash_rust::xxh3::xxh3_64(key.as_bytes());
         CeilingCache(cache.join(format!("ceiling-{hash:016x}.json")))
     }

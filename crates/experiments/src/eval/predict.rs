@@ -3,7 +3,7 @@
 
 use crate::data::TrainingData;
 use crate::{Error, Result};
-use brdf_neural::{BrdfModel, ModelConfig, Samples, split_k};
+use brdf_neural::{BrdfBatch, BrdfModel, ModelConfig, Samples, split_k};
 use burn::tensor::{Device, Tensor};
 
 /// Rows per forward pass.
@@ -86,9 +86,16 @@ fn forward_padded(
     spatial.resize(spatial.len() + pad * config.spatial_dim, 0.0);
     let padded = |d: &[[f32; 3]]| [d, &vec![[0.0, 0.0, 1.0]; pad]].concat();
     let batch = if pad == 0 {
-        config.batch_owned(spatial, samples.l, samples.v, None, device)?
+        BrdfBatch::from_owned(config, spatial, samples.l, samples.v, None, device)?
     } else {
-        config.batch_owned(spatial, &padded(samples.l), &padded(samples.v), None, device)?
+        BrdfBatch::from_owned(
+            config,
+            spatial,
+            &padded(samples.l),
+            &padded(samples.v),
+            None,
+            device,
+        )?
     };
     let rows = |t: Tensor<2>, what: &str| -> Result<Vec<[f32; 3]>> {
         let mut r = rows(t, what)?;
@@ -213,7 +220,7 @@ mod tests {
         let device = brdf_neural::device::cpu();
         for kind in [ModelKind::SingleMlp, ModelKind::AdditiveSharedEnhanced, ModelKind::Disney] {
             let config = ModelConfig { spatial_dim: 4, ..ModelConfig::new(kind) };
-            let model = config.init(&device).unwrap();
+            let model = BrdfModel::init(&config, &device).unwrap();
             let n = 37;
             let (spatial, l, v) = inputs(n);
             let samples = Samples { spatial: &spatial, l: &l, v: &v };
@@ -245,7 +252,7 @@ mod tests {
         assert!(!brdf_neural::device::is_cpu_device(&gpu));
         for kind in [ModelKind::SingleMlp, ModelKind::Disney] {
             let config = ModelConfig { spatial_dim: 4, ..ModelConfig::new(kind) };
-            let model = config.init(&cpu).unwrap();
+            let model = BrdfModel::init(&config, &cpu).unwrap();
             let on_gpu = model.clone().fork(&gpu);
             for n in [37, 1_500] {
                 let (spatial, l, v) = inputs(n);

@@ -15,9 +15,9 @@ use super::material::{ExportedMaterial, MaterialKind};
 use super::round_trip::{RoundTrip, round_trip};
 use super::{gltf, mitsuba, pbrt, test_pairs};
 use crate::eval::FittedRun;
-use crate::run_dir::RunDir;
 use crate::{Error, Result};
 use brdf_neural::BrdfModel;
+use run_format::run_dir::RunDir;
 use serde::Serialize;
 use std::path::Path;
 

@@ -15,7 +15,7 @@ use super::vertex_features;
 use crate::eval::FittedRun;
 use crate::{Error, Result};
 use brdf_analytic::{Brdf, Disney, DisneyParams, TorranceSparrow, TorranceSparrowParams};
-use brdf_neural::{BrdfModel, BrdfParams, Samples};
+use brdf_neural::{BrdfBatch, BrdfModel, BrdfParams, Samples};
 use burn::tensor::Tensor;
 
 /// Which analytic model a material's rows parametrise.
@@ -122,10 +122,7 @@ impl ExportedMaterial {
             let end = (start + CHUNK).min(n);
             let dirs = vec![[0.0, 0.0, 1.0f32]; end - start];
             let samples = Samples { spatial: &table[start * dim..end * dim], l: &dirs, v: &dirs };
-            let batch = fitted
-                .config
-                .model
-                .batch(&samples, None, &fitted.device)
+            let batch = BrdfBatch::new(&fitted.config.model, &samples, None, &fitted.device)
                 .map_err(|e| Error::config("model", e.to_string()))?;
             let (k, cols) = match model.params(batch.spatial) {
                 BrdfParams::Disney(p) => {

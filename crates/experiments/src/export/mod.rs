@@ -30,8 +30,8 @@ pub use material::{ExportedMaterial, MaterialKind};
 pub use merl::{MerlExport, export_merl, tabulate_merl};
 
 use crate::Result;
-use crate::config::{RunConfig, SpatialKind};
 use crate::data::lbo_table;
+use run_format::config::{RunConfig, SpatialKind};
 use scene::SceneDataset;
 use std::path::Path;
 

@@ -24,11 +24,11 @@
 //! layers, skips, angle features and encodings, heads), `spatial` (`kind`, `dim`) and
 //! `conventions` (frames and units, in words).
 
-use crate::config::RunConfig;
 use crate::export::vertex_features;
-use crate::run_dir::RunDir;
 use crate::{Error, Result};
 use burn::tensor::DType;
+use run_format::config::RunConfig;
+use run_format::run_dir::RunDir;
 use scene::SceneDataset;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -20,10 +20,10 @@ pub struct RoundTrip {
     /// Test images compared.
     pub images: usize,
     /// Lowest PSNR over the images, dB ("inf" in JSON when every image agrees exactly).
-    #[serde(with = "crate::eval::serde_inf")]
+    #[serde(with = "run_format::serde_inf")]
     pub min_psnr_db: f64,
     /// Mean PSNR, dB ("inf" when every image agrees exactly).
-    #[serde(with = "crate::eval::serde_inf")]
+    #[serde(with = "run_format::serde_inf")]
     pub mean_psnr_db: f64,
     /// Largest relative difference of a BRDF value (|a - b| / max(|b|, 1e-3), any channel).
     pub max_relative_brdf_difference: f64,

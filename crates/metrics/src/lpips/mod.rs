@@ -10,21 +10,24 @@
 //!
 //! The weights are not shipped (and these machines cannot download them): [`weights`] documents
 //! the file, its default location and how to make it; without it [`lpips_score`] returns
-//! [`Score::Unavailable`]`("weights missing")`, which tables print as "n/a (weights missing)".
+//! [`Score::Unavailable`](crate::aggregate::Score::Unavailable)`("weights missing")`, which tables print as "n/a (weights missing)".
 
+#[cfg(feature = "lpips")]
 mod net;
 pub mod weights;
 
+#[cfg(feature = "lpips")]
 pub use net::Lpips;
 
-use crate::aggregate::Score;
-use crate::error::Result;
-use crate::image::Image;
-use std::path::Path;
-
+#[cfg(feature = "lpips")]
 /// The LPIPS of two sRGB images in [0, 1] with the weights at `path`, or
 /// [`Score::Unavailable`] ("weights missing") when the file does not exist.
-pub fn lpips_score(test: &Image, reference: &Image, path: &Path) -> Result<Score> {
+pub fn lpips_score(
+    test: &crate::image::Image,
+    reference: &crate::image::Image,
+    path: &std::path::Path,
+) -> crate::error::Result<crate::aggregate::Score> {
+    use crate::aggregate::Score;
     if !path.exists() {
         return Ok(Score::Unavailable("weights missing".into()));
     }

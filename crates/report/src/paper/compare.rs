@@ -8,8 +8,8 @@ use crate::average::{average, final_records};
 use crate::record::{Dataset, Direction, MetricKind, RunOptions, RunRecord};
 use crate::result_tables::{Protocol, caption};
 use crate::table::{Cell, Column, ColumnGroup, Marking, Row, Table};
-use brdf_neural::ModelKind;
 use metrics::aggregate::Score;
+use model_spec::ModelKind;
 
 /// Why a paper cell is empty.
 const NOT_TRANSCRIBED: &str = "not transcribed";

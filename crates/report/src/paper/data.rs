@@ -4,7 +4,7 @@
 //! the other image metrics and RMSE∛ ×100); an empty cell is a value not transcribed.
 
 use crate::record::{Dataset, MetricKind};
-use brdf_neural::ModelKind;
+use model_spec::ModelKind;
 
 /// One of the paper's tables.
 #[derive(Clone, Debug, PartialEq)]

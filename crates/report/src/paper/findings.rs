@@ -6,7 +6,7 @@ use super::compare::ours as mean_of;
 use super::data::ModelGroup;
 use crate::average::{datasets, final_records};
 use crate::record::{Dataset, MetricKind, RunRecord};
-use brdf_neural::ModelKind;
+use model_spec::ModelKind;
 
 /// One of the paper's findings and whether our runs show it.
 #[derive(Clone, Debug, PartialEq)]

@@ -201,7 +201,7 @@ pub fn sentence(s: &str) -> String {
 mod tests {
     use super::*;
     use crate::record::MetricKind;
-    use brdf_neural::ModelKind;
+    use model_spec::ModelKind;
 
     #[test]
     fn the_comparison_names_what_is_missing_and_renders() {

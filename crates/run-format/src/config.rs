@@ -15,7 +15,7 @@
 //! [features.lbo]
 //! k_max = 512                # selection: 0..first, then `blocks` blocks of `block_len`
 //!
-//! [train]                    # see crate::train_config
+//! [train]                    # see run_format::train_config
 //! learning_rate = 1e-3
 //! schedule = "plateau"       # plateau | exponential | cosine | constant
 //! ```
@@ -47,9 +47,9 @@ pub struct RunConfig {
     pub features: FeatureConfig,
     /// Training schedule.
     pub train: TrainConfig,
-    /// What `eval` computes (defaults from the profile; see [`crate::eval::settings`]).
-    #[serde(default, skip_serializing_if = "crate::eval::EvalConfig::is_default")]
-    pub eval: crate::eval::EvalConfig,
+    /// What `eval` computes (defaults from the profile; see [`crate::eval_config`]).
+    #[serde(default, skip_serializing_if = "crate::eval_config::EvalConfig::is_default")]
+    pub eval: crate::eval_config::EvalConfig,
 }
 
 /// Spatial input of the networks.
@@ -75,7 +75,7 @@ pub struct FeatureConfig {
     /// LBO index selection.
     pub lbo: LboSelection,
     /// Cache directory (default: the sweep's `cache/` for a run of a sweep, else `cache/` beside
-    /// the run directory; `experiments::run_dir`).
+    /// the run directory; [`crate::run_dir`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cache_dir: Option<PathBuf>,
 }

@@ -31,16 +31,16 @@
 //! ```
 
 use super::plan::{self, Purpose};
-use crate::config::RunConfig;
-use crate::eval::ImageMetrics;
-use crate::plateau::StopReason;
-use crate::run_dir::{RunDir, RunMetrics, SweepLayout};
-use crate::{Error, Result};
+use experiments::{Error, Result};
 use metrics::aggregate::Score;
 use report::{
     self, Dataset, MetricKind, ModelRender, Protocol, QualitativeRow, RgbImage, RunOptions,
     RunRecord, Table,
 };
+use run_format::ImageMetrics;
+use run_format::config::RunConfig;
+use run_format::plateau::StopReason;
+use run_format::run_dir::{RunDir, RunMetrics, SweepLayout};
 use scene::flag;
 use std::path::{Path, PathBuf};
 

@@ -8,18 +8,15 @@
 //! directory.
 
 use super::profile::{Ablation, CaptureSource, SweepProfile, mesh_name};
-use crate::config::RunConfig;
-use crate::run_dir::RunDir;
-use crate::{Error, Result};
 use brdf_neural::{AngleParametrization, ModelKind, Reciprocity};
+use experiments::{Error, Result};
 use report::RunOptions;
+use run_format::config::RunConfig;
+use run_format::run_dir::RunDir;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// The version of the code that results depend on: bump it with any change that alters a
-/// result (training, models, data generation or metrics), so that content-addressed runs of
-/// the old code are not reused.
-pub const CODE_VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), "+results-3");
+pub use run_format::CODE_VERSION;
 
 /// Why a run is in the sweep.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -137,7 +134,7 @@ fn with_options(base: &RunConfig, kind: ModelKind, o: RunOptions) -> Result<RunC
 /// Every run of `profile`, deduplicated (a run planned twice keeps one entry with both
 /// purposes).
 pub fn runs(profile: &SweepProfile) -> Result<Vec<RunSpec>> {
-    let base = RunConfig::from_toml(&profile.run, Path::new(&format!("{} [run]", profile.origin)))?;
+    let base = profile.run.clone();
     let n_scenes = profile.scene_count();
     let mut out: Vec<RunSpec> = Vec::new();
     let mut push = |scene: usize, purpose: Purpose, config: RunConfig| {

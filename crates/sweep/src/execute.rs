@@ -10,13 +10,13 @@
 use super::heartbeat::Heartbeat;
 use super::plan::{self, Purpose, RunInfo, RunSpec, SceneSource, SceneSpec};
 use super::profile::{CaptureSource, SweepProfile, resolve_mesh};
-use crate::config::SpatialKind;
-use crate::eval::fitted::FittedRun;
-use crate::run_dir::{RunDir, SweepLayout};
-use crate::train::fit_and_keep;
-use crate::{Error, FitOptions, FitOutcome, Result};
 use brdf_neural::device::Backend;
 use dataset_merl::generate_scene;
+use experiments::eval::fitted::FittedRun;
+use experiments::train::fit_and_keep;
+use experiments::{Error, FitOptions, FitOutcome, Result};
+use run_format::config::SpatialKind;
+use run_format::run_dir::{RunDir, SweepLayout};
 use scene::SceneDataset;
 use scene::{MaterialSpec, SceneConfig, SceneSettings};
 use std::path::{Path, PathBuf};
@@ -118,10 +118,10 @@ pub fn run_one(run: &Path, progress: bool, backend: Backend) -> Result<()> {
         (FitOutcome::Stopped(step), _) => {
             return Err(Error::format(run, format!("training stopped at step {step}")));
         }
-        (_, Some(trained)) => FittedRun::from_trained(config, trained, cache),
+        (_, Some(trained)) => trained.into_fitted(config, cache),
         (_, None) => FittedRun::open_on(run, None, Some(&cache), backend)?,
     };
-    crate::eval::eval_fitted(&fitted, run, progress, Instant::now())?;
+    experiments::eval::eval_fitted(&fitted, run, progress, Instant::now())?;
     Ok(())
 }
 
@@ -245,7 +245,7 @@ pub fn prepare_features(specs: &[RunSpec], scene_dirs: &[PathBuf], cache: &Path)
         }
         seen.push(key);
         let scene = SceneDataset::open(&scene_dirs[spec.scene])?;
-        crate::data::lbo_table(&scene, &spec.config.features, cache)?;
+        experiments::data::lbo_table(&scene, &spec.config.features, cache)?;
     }
     Ok(())
 }

@@ -268,7 +268,7 @@ pub struct RunMetrics {
     pub snapshots: Vec<Snapshot>,
     /// Test metrics (`eval`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub test: Option<crate::eval::TestMetrics>,
+    pub test: Option<crate::test_metrics::TestMetrics>,
     /// Where the training time went, seconds per phase of the step (absent in runs trained
     /// before it was recorded).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -40,13 +40,13 @@ pub struct MetricSettings {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PaperProtocol {
     /// Mean scores over the test images (+inf PSNR for an exact render).
-    pub scores: super::ImageMetrics,
+    pub scores: crate::test_metrics::ImageMetrics,
     /// The same whole frames scored against the observations with their background set to 0
     /// instead of the noise-free renders: the other reading of the paper's protocol, which
     /// keeps the sensor noise in the reference (generated scenes; a capture's `scores` already
     /// are against its observations).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub observed: Option<super::ImageMetrics>,
+    pub observed: Option<crate::test_metrics::ImageMetrics>,
     /// How they were computed.
     pub settings: PaperSettings,
 }

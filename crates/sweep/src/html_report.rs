@@ -18,11 +18,11 @@
 //! by relative paths; every link of every page is checked to exist before `collect` returns.
 
 use super::collect::{CollectSummary, CollectedRun};
-use crate::run_dir::{RunDir, SweepLayout};
-use crate::{Error, Result};
+use experiments::{Error, Result};
 use report::html::{Page, check_well_formed, links};
 use report::paper::PaperComparison;
 use report::{LinePlot, Series, Table};
+use run_format::run_dir::{RunDir, SweepLayout};
 use std::path::{Component, Path, PathBuf};
 
 /// Test images shown per run page.
@@ -363,7 +363,7 @@ fn observed_png(
         return Ok(Some(path));
     }
     let Ok((w, h, px)) = scene::images::read_exr_rgb(&exr) else { return Ok(None) };
-    crate::eval::images::write_png_srgb(&path, w as u32, h as u32, &px)?;
+    experiments::eval::images::write_png_srgb(&path, w as u32, h as u32, &px)?;
     summary.files.push(path.clone());
     Ok(Some(path))
 }

@@ -1,12 +1,12 @@
 //! Where the time of a fit goes, per model kind: trains each run configuration of one scene of a
 //! finished sweep (for example the default's `out/reproduce`) for a fixed number of steps in a
 //! temporary directory, evaluates it, and prints milliseconds per step for each phase of the
-//! training step (`experiments::phases`) and seconds per phase of the evaluation.
+//! training step (`run_format::phases`) and seconds per phase of the evaluation.
 //!
 //! ```sh
 //! cargo xtask reproduce-tables            # once, for the scenes, caches and run configs
-//! cargo run --release -p experiments --example profile_steps -- out/reproduce spot__blue-acrylic 300
-//! cargo run --release -p experiments --features wgpu --example profile_steps -- out/reproduce spot__blue-acrylic 300 wgpu
+//! cargo run --release -p sweep --example profile_steps -- out/reproduce spot__blue-acrylic 300
+//! cargo run --release -p sweep --features wgpu --example profile_steps -- out/reproduce spot__blue-acrylic 300 wgpu
 //! ```
 //!
 //! `profile_steps --prepare <profile> <out>` makes a profile's scenes, caches and run
@@ -32,9 +32,8 @@
 //! measured steps. The warm-up table gives what it cost.
 
 use experiments::eval::eval_fitted;
-use experiments::eval::fitted::FittedRun;
-use experiments::run_dir::{RunDir, SweepLayout};
 use experiments::train::{FitOptions, fit_and_keep};
+use run_format::run_dir::{RunDir, SweepLayout};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -43,14 +42,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let [flag, profile, out] = args.as_slice()
         && flag == "--prepare"
     {
-        let profile = experiments::sweep::SweepProfile::load(profile)?;
-        let how = experiments::sweep::Execution::Emit {
+        let profile = sweep::SweepProfile::load(profile)?;
+        let how = sweep::Execution::Emit {
             file: PathBuf::from(out).join("jobs.txt"),
             command: vec!["profile_steps".into()],
         };
         let data = std::env::var_os("NEURAL_BRDF_DATA")
             .map_or_else(|| PathBuf::from("data"), PathBuf::from);
-        let s = experiments::sweep::sweep(&profile, out.as_ref(), &data, &how)?;
+        let s = sweep::sweep(&profile, out.as_ref(), &data, &how)?;
         println!(
             "{}: {} scenes generated, {} runs planned",
             profile.name,
@@ -124,7 +123,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         let (outcome, trained) = fit_and_keep(&config, &run, options())?;
         let trained = trained.ok_or_else(|| format!("{kind}: did not train ({outcome:?})"))?;
-        let metrics = experiments::run_dir::RunMetrics::read(&RunDir::new(&run).metrics())?;
+        let metrics = run_format::RunMetrics::read(&RunDir::new(&run).metrics())?;
         let phases = metrics.phases.unwrap_or_default();
         let cells: Vec<String> =
             phases.per_step_ms().iter().map(|(_, ms)| format!("{ms:.1}")).collect();
@@ -137,7 +136,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if eval_only.as_ref().is_some_and(|e| !e.contains(&kind.as_str())) {
             continue;
         }
-        let fitted = FittedRun::from_trained(config, trained, layout.cache());
+        let fitted = trained.into_fitted(config, layout.cache());
         for round in 1..=eval_repeat {
             let start = Instant::now();
             let test = eval_fitted(&fitted, &run, false, start)?;

@@ -11,7 +11,7 @@
 //! `NEURAL_BRDF_PROGRESS_LINES=1` prints them on a terminal too (`0`: never);
 //! `NEURAL_BRDF_PROGRESS_SECS` sets the interval (default 30).
 
-use crate::run_dir::RunDir;
+use run_format::run_dir::RunDir;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};

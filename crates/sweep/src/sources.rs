@@ -9,14 +9,14 @@
 //! (`neural-brdfs-embedded-<xxh3 of the OBJ>/`, atomically, beside its `NOTICE.md`), whose path
 //! is the same in every process and checkout on the machine.
 
-use crate::{Error, Result};
+use experiments::{Error, Result};
 use std::path::{Path, PathBuf};
 
 /// The meshes shipped inside the binary: (name, OBJ bytes, notice).
 const EMBEDDED: [(&str, &[u8], &str); 1] = [(
     "spot",
-    include_bytes!("../../../../data-manifests/embedded/spot/spot.obj"),
-    include_str!("../../../../data-manifests/embedded/spot/NOTICE.md"),
+    include_bytes!("../../../data-manifests/embedded/spot/spot.obj"),
+    include_str!("../../../data-manifests/embedded/spot/NOTICE.md"),
 )];
 
 /// The names of the embedded meshes.

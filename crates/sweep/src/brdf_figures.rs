@@ -16,11 +16,11 @@
 
 use super::collect::{CollectSummary, CollectedRun};
 use super::plan::Purpose;
-use crate::Result;
-use crate::eval::probe;
-use crate::run_dir::{RunDir, SweepLayout};
+use experiments::Result;
+use experiments::eval::probe;
 use report::RunOptions;
 use report::brdf_plots::{self, BrdfProbe};
+use run_format::run_dir::{RunDir, SweepLayout};
 use std::path::Path;
 
 /// The ground truth's probe of the scene at `scene` (`None` for captured scenes, or when the

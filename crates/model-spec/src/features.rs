@@ -1,8 +1,8 @@
 //! Direction features of the purely neural models: the angle parametrization, the reciprocity
 //! option and the positional encoding (spec sections 2, 4.6 and 5.1).
 //!
-//! Features are computed on the CPU with the `angles` crate, in f32, and uploaded as a tensor.
-//! `angles` computes every quantity symmetrically in l and v, so with
+//! Features are computed on the CPU with the `angles` crate, in f32 (brdf-neural uploads them as
+//! a tensor). `angles` computes every quantity symmetrically in l and v, so with
 //! [`Reciprocity::Mapping`] the feature row of (l, v) is bit-identical to that of (v, l); any
 //! network fed it is then exactly reciprocal. [`Reciprocity::RandomSwap`] swaps l and v in the
 //! network input of a training sample with probability `swap_probability` (LitNeRF); rendering

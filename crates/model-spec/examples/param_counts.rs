@@ -1,9 +1,9 @@
 //! Prints the number of trainable parameters of every model (default configuration, with the
 //! reciprocity mapping, and the NOL ablation), as a Markdown table.
 //!
-//! `cargo run -p brdf-neural --example param_counts`
+//! `cargo run -p model-spec --example param_counts`
 
-use brdf_neural::{ModelConfig, ModelKind, Reciprocity};
+use model_spec::{ModelConfig, ModelKind, Reciprocity};
 
 fn main() {
     println!("| model | default | mapping | NOL |\n| --- | ---: | ---: | ---: |");

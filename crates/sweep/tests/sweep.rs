@@ -5,8 +5,8 @@
 //! one command per unfinished run. The built-in smoke profile end to end, with its HTML report
 //! checked (and opened in headless Chromium where installed).
 
-use experiments::sweep::{self, Execution, SweepProfile};
 use std::path::PathBuf;
+use sweep::{Execution, SweepProfile};
 
 use test_support as support;
 

@@ -1,6 +1,6 @@
 //! Sweep profiles: which scenes, models, ablations and training budgets a reproduction runs.
 //!
-//! A profile is a TOML file. The built-in ones live in `crates/experiments/profiles/` and are
+//! A profile is a TOML file. The built-in ones live in `crates/sweep/profiles/` and are
 //! compiled in (`default`, `smoke`, `quick`, `runtime`, `full`, `real`); `--profile` takes one of those names or
 //! a path to a file of the same shape:
 //!
@@ -18,7 +18,7 @@
 //! captures = ["diligent:ball"]    # real captures, imported as scenes (see [`CaptureSource`])
 //! optional_captures = ["diligent-mv:bear"]   # the same, used when present under the data root
 //!
-//! [run]                           # a run configuration (see `experiments::config`), shared
+//! [run]                           # a run configuration (see `run_format::config`), shared
 //! seed = 1
 //! [run.train]
 //! iterations = 1000
@@ -33,20 +33,21 @@
 //! Every key is checked: unknown keys are errors that name the key and the file.
 
 pub use super::sources::{CaptureSource, mesh_name, resolve_mesh};
-use crate::{Error, Result};
 use brdf_neural::ModelKind;
 use brdf_neural::precision::MatmulPrecision;
+use experiments::{Error, Result};
+use run_format::RunConfig;
 use serde::Deserialize;
 use std::path::Path;
 
 /// The built-in profiles: (name, TOML text).
 pub const BUILT_IN: [(&str, &str); 6] = [
-    ("default", include_str!("../../profiles/default.toml")),
-    ("smoke", include_str!("../../profiles/smoke.toml")),
-    ("quick", include_str!("../../profiles/quick.toml")),
-    ("runtime", include_str!("../../profiles/runtime.toml")),
-    ("full", include_str!("../../profiles/full.toml")),
-    ("real", include_str!("../../profiles/real.toml")),
+    ("default", include_str!("../profiles/default.toml")),
+    ("smoke", include_str!("../profiles/smoke.toml")),
+    ("quick", include_str!("../profiles/quick.toml")),
+    ("runtime", include_str!("../profiles/runtime.toml")),
+    ("full", include_str!("../profiles/full.toml")),
+    ("real", include_str!("../profiles/real.toml")),
 ];
 
 /// The profile `reproduce-tables` runs without `--profile`: Table 1 with every run trained to
@@ -128,8 +129,9 @@ pub struct SweepProfile {
     pub description: String,
     /// The scenes.
     pub data: DataSection,
-    /// The shared run configuration, as TOML text (a valid `RunConfig` fragment).
-    pub run: String,
+    /// The run configuration every run shares (the profile's `[run]` table); each run sets
+    /// its model on a copy.
+    pub run: RunConfig,
     /// What runs.
     pub sweep: SweepSection,
     /// Where it came from (a built-in name or a path), for errors.
@@ -189,6 +191,7 @@ impl SweepProfile {
             .map_err(|e| Error::ConfigParse { path: origin.into(), message: e.to_string() })?;
         let run = toml::to_string(&raw.run)
             .map_err(|e| Error::ConfigParse { path: origin.into(), message: e.to_string() })?;
+        let run = RunConfig::from_toml(&run, Path::new(&format!("{origin} [run]")))?;
         let p = SweepProfile {
             name: raw.name,
             description: raw.description,
@@ -204,17 +207,9 @@ impl SweepProfile {
     /// Sets `train.matmul_precision` in the run configuration every run shares
     /// (`reproduce-tables --matmul-precision`). A bf16 run gets its own run id, so a sweep
     /// never mixes precisions in one run directory.
-    pub fn with_matmul_precision(mut self, precision: MatmulPrecision) -> Result<Self> {
-        let parse = |e: String| Error::ConfigParse { path: self.origin.clone().into(), message: e };
-        let mut run: toml::Table = toml::from_str(&self.run).map_err(|e| parse(e.to_string()))?;
-        let train = run.entry("train").or_insert_with(|| toml::Value::Table(Default::default()));
-        let Some(train) = train.as_table_mut() else {
-            return Err(Error::config("run.train", format!("is not a table (in {})", self.origin)));
-        };
-        train.insert("matmul_precision".into(), toml::Value::String(precision.name().into()));
-        self.run = toml::to_string(&run).map_err(|e| parse(e.to_string()))?;
-        self.validate()?;
-        Ok(self)
+    pub fn with_matmul_precision(mut self, precision: MatmulPrecision) -> Self {
+        self.run.train.matmul_precision = precision;
+        self
     }
 
     fn validate(&self) -> Result<()> {
@@ -258,7 +253,6 @@ impl SweepProfile {
                 format!("{} but there are {} scenes", self.sweep.runtime_scene, self.scene_count()),
             );
         }
-        crate::RunConfig::from_toml(&self.run, Path::new(&format!("{} [run]", self.origin)))?;
         Ok(())
     }
 
@@ -388,8 +382,7 @@ mod tests {
         let p = SweepProfile::load(path).unwrap();
         assert_eq!(p.scene_count(), 1);
         assert_eq!(p.models().unwrap().len(), 9);
-        let config = crate::RunConfig::from_toml(&p.run, Path::new(path)).unwrap();
-        assert_eq!(config.eval.energy_estimator, Some(crate::eval::EnergyEstimator::Fast));
+        assert_eq!(p.run.eval.energy_estimator, Some(run_format::EnergyEstimator::Fast));
     }
 
     #[test]
@@ -450,17 +443,16 @@ mod tests {
     fn matmul_precision_reaches_every_run_config() {
         let p = SweepProfile::load("smoke").unwrap();
         let ids = |p: &SweepProfile| -> Vec<String> {
-            let runs = crate::sweep::plan::runs(p).unwrap();
-            runs.iter().map(|r| crate::sweep::plan::run_id(&r.config, "scene").unwrap()).collect()
+            let runs = crate::plan::runs(p).unwrap();
+            runs.iter().map(|r| crate::plan::run_id(&r.config, "scene").unwrap()).collect()
         };
         let before = ids(&p);
-        let bf16 = p.clone().with_matmul_precision(MatmulPrecision::Bf16).unwrap();
-        let config = crate::RunConfig::from_toml(&bf16.run, Path::new("test")).unwrap();
-        assert_eq!(config.train.matmul_precision, MatmulPrecision::Bf16);
+        let bf16 = p.clone().with_matmul_precision(MatmulPrecision::Bf16);
+        assert_eq!(bf16.run.train.matmul_precision, MatmulPrecision::Bf16);
         let after = ids(&bf16);
         assert_eq!(before.len(), after.len());
         assert!(before.iter().zip(&after).all(|(a, b)| a != b), "bf16 runs need their own ids");
         // f32 is the default: setting it explicitly changes no run id.
-        assert_eq!(ids(&p.with_matmul_precision(MatmulPrecision::F32).unwrap()), before);
+        assert_eq!(ids(&p.with_matmul_precision(MatmulPrecision::F32)), before);
     }
 }

@@ -1,0 +1,259 @@
+//! The subcommands on one run directory, shared by both command lines so they cannot
+//! disagree: `experiments <command>` and `cargo xtask <command>` parse the same [`RunCommand`]
+//! and run it with [`run`]. `fit` trains a model on a scene into a run directory, `eval`
+//! renders the test images of a finished run and computes its metrics, `energy` re-runs the
+//! energy analysis with another estimator, `export` writes a Disney or Torrance-Sparrow fit as
+//! glTF 2.0, Mitsuba 3 and pbrt-v4 files (a purely neural fit as a Mitsuba 3 scene for the
+//! Python package's `neural_brdf` plugin), `export-merl` any fit as a MERL binary.
+
+use crate::export::SurfacePoint;
+use crate::{FitOptions, FitOutcome};
+use anyhow::{Context, Result, bail};
+use brdf_neural::device::Backend;
+use clap::Subcommand;
+use run_format::EnergyEstimator;
+use run_format::config::RunConfig;
+use run_format::run_dir::RunDir;
+use std::path::{Path, PathBuf};
+
+/// A command on one run: fit, evaluate, analyse or export it.
+#[derive(Subcommand)]
+pub enum RunCommand {
+    /// Train a model on a scene's training split into a run directory (resumes an existing run
+    /// from its last checkpoint; a finished run is reported and skipped).
+    Fit {
+        /// Run configuration (TOML). Optional when RUN already holds a config.toml.
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Scene directory (overrides `scene` in the config).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Run directory.
+        #[arg(long)]
+        out: PathBuf,
+        /// Cache directory (default: `features.cache_dir`, else the sweep's `cache/` for a sweep
+        /// run, else `<out>/../cache`).
+        #[arg(long)]
+        cache: Option<PathBuf>,
+        /// The burn backend: `cpu` (default), `wgpu` or `cuda` (GPU builds: `--features wgpu`
+        /// or `cuda`), also `flex` or `ndarray`.
+        #[arg(long, default_value = "cpu", value_parser = parse_backend)]
+        backend: Backend,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Render the test images of a finished run into `<run>/renders/` and add the test metrics
+    /// (PSNR, DSSIM, HDR-FLIP, cube-root RMSE) to `<run>/metrics.json`.
+    Eval {
+        /// Run directory.
+        run: PathBuf,
+        /// Scene directory (default: the one in the run's config).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Cache directory (default: `features.cache_dir`, else the sweep's `cache/` for a sweep
+        /// run, else `<run>/../cache`).
+        #[arg(long)]
+        cache: Option<PathBuf>,
+        /// The burn backend: `cpu` (default), `wgpu` or `cuda` (GPU builds: `--features wgpu`
+        /// or `cuda`), also `flex` or `ndarray`.
+        #[arg(long, default_value = "cpu", value_parser = parse_backend)]
+        backend: Backend,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Energy conservation of a finished run's model with a chosen estimator (the paper's
+    /// Monte Carlo or the fast importance-sampled QMC), printed as JSON; the run is unchanged.
+    Energy {
+        /// Run directory.
+        run: PathBuf,
+        /// `fast`, `paper` (20,000 cosine samples a pair) or `off`.
+        #[arg(long, default_value = "fast")]
+        estimator: String,
+        /// (x, l) pairs (default: the run's `[eval]` setting).
+        #[arg(long)]
+        pairs: Option<usize>,
+        /// Cache directory (default: `features.cache_dir`, else the sweep's `cache/` for a sweep
+        /// run, else `<run>/../cache`).
+        #[arg(long)]
+        cache: Option<PathBuf>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Write a finished Disney or Torrance-Sparrow run as renderer files: glTF 2.0
+    /// (`<out>/gltf`), a Mitsuba 3 scene (`<out>/mitsuba`) and a pbrt-v4 scene (`<out>/pbrt`),
+    /// the last two with a scene file per test view and light; `<out>/export.json` reports the
+    /// round trip (the test views re-rendered from the glTF file against the fit's renders).
+    /// A purely neural run (Single MLP, the additive models) exports to Mitsuba 3 only: the
+    /// scenes with a `neural_brdf` BSDF on the run's weights, rendered by the Python package's
+    /// plugin (`import neural_brdfs.mitsuba`).
+    Export {
+        /// Run directory.
+        run: PathBuf,
+        /// Output folder (replaced atomically).
+        #[arg(long)]
+        out: PathBuf,
+        /// Formats, comma-separated: gltf, mitsuba, pbrt or all.
+        #[arg(long, default_value = "all")]
+        format: String,
+        /// Scene directory (default: the one in the run's config).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Cache directory (default: `features.cache_dir`, else the sweep's `cache/` for a sweep
+        /// run, else `<run>/../cache`).
+        #[arg(long)]
+        cache: Option<PathBuf>,
+    },
+    /// Write a finished run's fitted material as a MERL binary (90 x 90 x 180 bins) at one
+    /// surface point, for any renderer that reads MERL files.
+    ExportMerl {
+        /// Run directory.
+        run: PathBuf,
+        /// Output file (conventionally `<name>.binary`).
+        #[arg(long)]
+        out: PathBuf,
+        /// Mesh vertex to evaluate at (default: the vertex whose encoding is closest to the
+        /// mesh average).
+        #[arg(long)]
+        vertex: Option<usize>,
+        /// Scene directory (default: the one in the run's config).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Cache directory (default: `features.cache_dir`, else the sweep's `cache/` for a sweep
+        /// run, else `<run>/../cache`).
+        #[arg(long)]
+        cache: Option<PathBuf>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+}
+
+/// `--backend`: a backend name (see `brdf_neural::device`).
+pub fn parse_backend(name: &str) -> std::result::Result<Backend, String> {
+    Backend::parse(name).map_err(|e| e.to_string())
+}
+
+/// Runs one subcommand, printing its outcome.
+pub fn run(command: RunCommand) -> Result<()> {
+    match command {
+        RunCommand::Fit { config, scene, out, cache, backend, quiet } => {
+            fit_command(config, scene, &out, cache, backend, quiet)?;
+        }
+        RunCommand::Eval { run, scene, cache, backend, quiet } => {
+            let metrics =
+                crate::eval::eval(&run, scene.as_deref(), cache.as_deref(), backend, !quiet)
+                    .with_context(|| format!("eval of {}", run.display()))?;
+            println!("{}", serde_json::to_string_pretty(&metrics)?);
+        }
+        RunCommand::Energy { run, estimator, pairs, cache, quiet } => {
+            let estimator = match estimator.as_str() {
+                "fast" => EnergyEstimator::Fast,
+                "paper" => EnergyEstimator::Paper,
+                "off" => EnergyEstimator::Off,
+                other => bail!("--estimator {other:?}: expected fast, paper or off"),
+            };
+            let e = crate::eval::energy_of_run(&run, estimator, pairs, cache.as_deref(), !quiet)
+                .with_context(|| format!("energy of {}", run.display()))?;
+            println!("{}", serde_json::to_string_pretty(&e)?);
+        }
+        RunCommand::Export { run, out, format, scene, cache } => {
+            let formats = crate::export::Format::parse_list(&format)?;
+            let e = crate::export::export(&run, &out, &formats, scene.as_deref(), cache.as_deref())
+                .with_context(|| format!("export of {}", run.display()))?;
+            println!(
+                "wrote {} files for a {} {} fit ({} vertices, {} test pairs) into {} in {:.1} s",
+                e.files.len(),
+                if e.uniform { "spatially uniform" } else { "spatially varying" },
+                e.model,
+                e.vertices,
+                e.test_pairs,
+                out.display(),
+                e.seconds
+            );
+            if let Some(t) = &e.round_trip {
+                println!(
+                    "round trip (glTF read back, {} test images re-rendered): PSNR min {:.1} dB, \
+                     mean {:.1} dB; largest relative BRDF difference {:.2e}",
+                    t.images, t.min_psnr_db, t.mean_psnr_db, t.max_relative_brdf_difference
+                );
+            }
+        }
+        RunCommand::ExportMerl { run, out, vertex, scene, cache, quiet } => {
+            let point = vertex.map_or(SurfacePoint::Representative, SurfacePoint::Vertex);
+            let e = crate::export::export_merl(
+                &run,
+                &out,
+                point,
+                scene.as_deref(),
+                cache.as_deref(),
+                !quiet,
+            )
+            .with_context(|| format!("export-merl of {}", run.display()))?;
+            println!(
+                "wrote {} (vertex {} at {:?}; {} below-horizon bins set to 0) in {:.1} s",
+                out.display(),
+                e.vertex,
+                e.position,
+                e.below_horizon,
+                e.seconds
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `experiments fit`: the configuration from `--config` or the run directory, the scene from
+/// `--scene` when given; prints how the fit ended.
+fn fit_command(
+    config: Option<PathBuf>,
+    scene: Option<PathBuf>,
+    out: &Path,
+    cache: Option<PathBuf>,
+    backend: Backend,
+    quiet: bool,
+) -> Result<()> {
+    let stored = RunDir::new(out).config();
+    let path = match config {
+        Some(p) => p,
+        None if stored.is_file() => stored,
+        None => bail!("--config is required for a new run ({} has none)", out.display()),
+    };
+    let mut cfg = RunConfig::read(&path)?;
+    if let Some(scene) = scene {
+        cfg.scene = Some(std::path::absolute(&scene).unwrap_or(scene));
+    }
+    let options = FitOptions { progress: !quiet, cache_dir: cache, backend, ..Default::default() };
+    match crate::fit(&cfg, out, options).with_context(|| format!("fit into {}", out.display()))? {
+        FitOutcome::AlreadyFinished(m) => {
+            println!("{}: already finished ({} steps), skipped", out.display(), m.steps)
+        }
+        FitOutcome::Finished { metrics: m, resumed_from } => {
+            if resumed_from > 0 {
+                println!("resumed from step {resumed_from}");
+            }
+            let why = match m.stop_reason {
+                Some(run_format::plateau::StopReason::Plateau) => "converged",
+                _ => "step budget reached",
+            };
+            let val = match (m.best_val_loss, m.val_loss_floor) {
+                (Some(v), Some(f)) => format!(", validation {v:.4e} (noise floor {f:.4e})"),
+                (Some(v), None) => format!(", validation {v:.4e}"),
+                _ => String::new(),
+            };
+            println!(
+                "{}: {} after {} steps in {:.1} s, {:.0} samples/s, final loss {:.4e}{val}",
+                out.display(),
+                why,
+                m.steps,
+                m.wall_seconds,
+                m.samples_per_second,
+                m.final_train_loss
+            );
+        }
+        FitOutcome::Stopped(step) => println!("stopped after step {step}"),
+    }
+    Ok(())
+}

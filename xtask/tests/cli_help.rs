@@ -1,0 +1,59 @@
+//! One command line: every `cargo xtask` subcommand answers `--help`, and the commands on one
+//! run directory are the `experiments` binary's own (the same parser, [`RunCommand`]), with the
+//! same options.
+
+use clap::Subcommand;
+use experiments::cli::RunCommand;
+use std::process::Command;
+
+fn xtask(args: &[&str]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_xtask")).args(args).output().unwrap();
+    let text =
+        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "xtask {args:?} failed:\n{text}");
+    text
+}
+
+/// The subcommand names of a `--help` text's "Commands:" list.
+fn commands(help: &str) -> Vec<String> {
+    help.lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter_map(|l| l.split_whitespace().next().map(str::to_string))
+        .filter(|c| c != "help")
+        .collect()
+}
+
+/// The long options of a help text, sorted.
+fn options(help: &str) -> Vec<String> {
+    let mut o: Vec<String> = help
+        .split_whitespace()
+        .filter(|w| w.starts_with("--"))
+        .map(|w| w.trim_end_matches([',', '.', ')', '`']).to_string())
+        .collect();
+    o.sort();
+    o.dedup();
+    o
+}
+
+#[test]
+fn every_subcommand_has_help_and_the_run_commands_match_the_experiments_binary() {
+    let top = xtask(&["--help"]);
+    let listed = commands(&top);
+    assert!(listed.len() >= 15, "{top}");
+    for c in &listed {
+        let help = xtask(&[c, "--help"]);
+        assert!(help.contains(&format!("Usage: xtask {c}")), "{c}: {help}");
+    }
+    let mut run = RunCommand::augment_subcommands(clap::Command::new("experiments"));
+    run.build();
+    let names: Vec<String> =
+        run.get_subcommands().map(|s| s.get_name().to_string()).filter(|n| n != "help").collect();
+    assert_eq!(names, ["fit", "eval", "energy", "export", "export-merl"]);
+    for name in &names {
+        assert!(listed.contains(name), "xtask lacks {name}: {top}");
+        let ours = run.find_subcommand_mut(name).unwrap().render_long_help().to_string();
+        assert_eq!(options(&xtask(&[name, "--help"])), options(&ours), "{name}");
+    }
+}
