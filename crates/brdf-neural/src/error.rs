@@ -6,13 +6,11 @@ use crate::device::Backend;
 /// model never fails.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
-    /// A model configuration combines options the paper does not combine, or has a value out
-    /// of range; the message names the field.
-    #[error("invalid model configuration: {0}")]
-    InvalidConfig(String),
-    /// A model name that is neither a configuration name nor a paper table row.
-    #[error("unknown model name {0:?} (see ModelKind::ALL for the names)")]
-    UnknownModel(String),
+    /// A model configuration that combines options the paper does not combine or has a value
+    /// out of range, or an unknown model name (model-spec's error; the message names the
+    /// field or the name).
+    #[error(transparent)]
+    Spec(#[from] model_spec::Error),
     /// A backend name other than cpu, flex, ndarray, wgpu or cuda.
     #[error("unknown backend {0:?} (expected cpu, flex, ndarray, wgpu or cuda)")]
     UnknownBackend(String),
@@ -29,32 +27,5 @@ pub enum Error {
     BatchShape(String),
 }
 
-/// The configuration errors of `model-spec` become the variants of the same names (and the
-/// same messages).
-impl From<model_spec::Error> for Error {
-    fn from(e: model_spec::Error) -> Self {
-        match e {
-            model_spec::Error::InvalidConfig(m) => Error::InvalidConfig(m),
-            model_spec::Error::UnknownModel(m) => Error::UnknownModel(m),
-        }
-    }
-}
-
 /// `Result` with this crate's [`Error`].
 pub type Result<T> = std::result::Result<T, Error>;
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn model_spec_errors_keep_their_messages() {
-        for e in [
-            model_spec::Error::InvalidConfig("width must be positive".into()),
-            model_spec::Error::UnknownModel("mlp".into()),
-        ] {
-            let text = e.to_string();
-            assert_eq!(Error::from(e).to_string(), text);
-        }
-    }
-}

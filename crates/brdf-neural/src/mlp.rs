@@ -130,26 +130,21 @@ mod tests {
     use burn::module::Module;
 
     #[test]
-    fn param_count_matches_module_and_concatenation_form() {
+    fn param_count_matches_module() {
         // Its forward pass below draws the initial weights: under the lock the model tests of
         // this binary compare their draws under.
         let _draws = crate::model::initial_draws();
         let device = crate::device::cpu();
+        // model-spec's tests hold `param_count` to the concatenation form; here the built
+        // module has exactly that many scalars, with the late input at layer 0 and at layer 3.
         let mut c = MlpConfig::new(10);
         c.width = 8;
         c.d_output = Some(3);
         c.skip_into = Some(3);
         c.d_late = 4;
-        // Concatenation form: layer 0 (14 -> 8), 1, 2 (8 -> 8), 3 ([8, 14] -> 8), 4 (8 -> 8),
-        // 5 (8 -> 3).
-        let expect = (14 * 8 + 8) + 2 * (8 * 8 + 8) + (22 * 8 + 8) + (8 * 8 + 8) + (8 * 3 + 3);
-        assert_eq!(c.param_count(), expect);
-        assert_eq!(Mlp::new(&c, &device).num_params(), expect);
-        // Late input at layer 3: it leaves layer 0 and the skip (both lose 4 x 8 weights) and
-        // gets its own 4 x 8 projection.
+        assert_eq!(Mlp::new(&c, &device).num_params(), c.param_count());
         c.late_into = 3;
         assert_eq!(Mlp::new(&c, &device).num_params(), c.param_count());
-        assert_eq!(c.param_count(), expect - 4 * 8);
         let y = Mlp::new(&c, &device)
             .forward(Tensor::<2>::ones([2, 10], &device), Some(Tensor::<2>::ones([2, 4], &device)));
         assert_eq!(y.dims(), [2, 3]);

@@ -49,16 +49,17 @@ impl MatmulPrecision {
     /// until the guard drops.
     ///
     /// # Errors
-    /// [`crate::Error::InvalidConfig`] for bf16 on a backend other than flex.
+    /// [`crate::Error::Spec`] (an invalid configuration) for bf16 on a backend other than flex.
     pub fn scope(self, backend: crate::device::Backend) -> crate::Result<PrecisionGuard> {
         if self == MatmulPrecision::F32 {
             return Ok(PrecisionGuard { previous: None });
         }
         if backend != crate::device::Backend::Flex {
-            return Err(crate::Error::InvalidConfig(format!(
+            return Err(model_spec::Error::InvalidConfig(format!(
                 "matmul precision bf16 is implemented for the flex CPU backend only, not {}",
                 backend.name()
-            )));
+            ))
+            .into());
         }
         Ok(PrecisionGuard { previous: Some(set(self)) })
     }

@@ -5,39 +5,10 @@ use std::path::PathBuf;
 /// Errors of training, evaluation, export and sweeps.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
-    /// A configuration file could not be parsed (unknown key, wrong type); serde's message
-    /// names the key.
-    #[error("{}: {message}", path.display())]
-    ConfigParse {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong.
-        message: String,
-    },
-    /// A configuration value is out of range.
-    #[error("config key `{key}`: {message}")]
-    Config {
-        /// The dotted key, e.g. `train.learning_rate`.
-        key: String,
-        /// What is wrong.
-        message: String,
-    },
-    /// File system error.
-    #[error("{}: {source}", path.display())]
-    Io {
-        /// The file or directory.
-        path: PathBuf,
-        /// The cause.
-        source: std::io::Error,
-    },
-    /// A file has unexpected content.
-    #[error("{}: {message}", path.display())]
-    Format {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong.
-        message: String,
-    },
+    /// A run's configuration or files: a key out of range, a file that cannot be parsed, read
+    /// or written (run-format's error, which names the file or the key).
+    #[error(transparent)]
+    Run(#[from] run_format::Error),
     /// The MERL catalogue or the scene generator failed.
     #[error(transparent)]
     Dataset(#[from] dataset_merl::Error),
@@ -108,29 +79,26 @@ pub enum Error {
 impl Error {
     /// A range error for `key`.
     pub fn config(key: &str, message: impl Into<String>) -> Self {
-        Error::Config { key: key.into(), message: message.into() }
+        run_format::Error::config(key, message).into()
     }
 
     /// A range error of the configuration file `path`, named with it (`path: config key
     /// \`train.batch_size\`: ...`); other errors are returned as they are.
     pub fn in_file(self, path: impl Into<PathBuf>) -> Self {
         match self {
-            Error::Config { key, message } => Error::ConfigParse {
-                path: path.into(),
-                message: format!("config key `{key}`: {message}"),
-            },
+            Error::Run(e) => Error::Run(e.in_file(path)),
             other => other,
         }
     }
 
     /// An I/O error on `path`.
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
-        Error::Io { path: path.into(), source }
+        run_format::Error::io(path, source).into()
     }
 
     /// A format error in `path`.
     pub fn format(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
-        Error::Format { path: path.into(), message: message.into() }
+        run_format::Error::format(path, message).into()
     }
 }
 
@@ -139,20 +107,6 @@ pub type Result<T> = std::result::Result<T, Error>;
 
 impl From<stdx::fs::Error> for Error {
     fn from(e: stdx::fs::Error) -> Self {
-        Self::Io { path: e.path, source: e.source }
-    }
-}
-
-impl From<run_format::Error> for Error {
-    /// The same variant: a run's files fail the same way whichever stage reads them.
-    fn from(e: run_format::Error) -> Self {
-        match e {
-            run_format::Error::ConfigParse { path, message } => {
-                Error::ConfigParse { path, message }
-            }
-            run_format::Error::Config { key, message } => Error::Config { key, message },
-            run_format::Error::Io { path, source } => Error::Io { path, source },
-            run_format::Error::Format { path, message } => Error::Format { path, message },
-        }
+        Error::Run(e.into())
     }
 }

@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 /// `ValueError`.
 fn run_error(e: experiments::Error) -> PyErr {
     match e {
-        experiments::Error::Io { .. } => PyOSError::new_err(e.to_string()),
+        experiments::Error::Run(run_format::Error::Io { .. }) => PyOSError::new_err(e.to_string()),
         _ => PyValueError::new_err(e.to_string()),
     }
 }

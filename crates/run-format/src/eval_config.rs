@@ -22,7 +22,7 @@
 //! gives the paper's answer with error bars 10 to 1000 times smaller at a fraction of the
 //! evaluations; the full profile keeps the paper's protocol for fidelity.
 
-use crate::config::Profile;
+use crate::train_config::Profile;
 use crate::{Error, Result};
 use metrics::energy::Estimator;
 use serde::{Deserialize, Serialize};

@@ -36,21 +36,6 @@ pub struct MetricSettings {
     pub aggregation: String,
 }
 
-/// The scores of a run under the paper's protocol, with its settings.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct PaperProtocol {
-    /// Mean scores over the test images (+inf PSNR for an exact render).
-    pub scores: crate::test_metrics::ImageMetrics,
-    /// The same whole frames scored against the observations with their background set to 0
-    /// instead of the noise-free renders: the other reading of the paper's protocol, which
-    /// keeps the sensor noise in the reference (generated scenes; a capture's `scores` already
-    /// are against its observations).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub observed: Option<crate::test_metrics::ImageMetrics>,
-    /// How they were computed.
-    pub settings: PaperSettings,
-}
-
 /// The settings of the paper's protocol.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PaperSettings {

@@ -66,6 +66,21 @@ pub struct EnergySummary {
     pub seconds: f64,
 }
 
+/// The scores of a run under the paper's protocol, with its settings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PaperProtocol {
+    /// Mean scores over the test images (+inf PSNR for an exact render).
+    pub scores: ImageMetrics,
+    /// The same whole frames scored against the observations with their background set to 0
+    /// instead of the noise-free renders: the other reading of the paper's protocol, which
+    /// keeps the sensor noise in the reference (generated scenes; a capture's `scores` already
+    /// are against its observations).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub observed: Option<ImageMetrics>,
+    /// How they were computed.
+    pub settings: metric_settings::PaperSettings,
+}
+
 /// One point of a run's run-time curve: the test scores of a weight snapshot.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CurvePoint {
@@ -100,7 +115,7 @@ pub struct TestMetrics {
     /// The paper's protocol: the whole frame against the noise-free renders, with its
     /// settings (absent in runs evaluated before it was added; the sweep re-evaluates them).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub paper: Option<metric_settings::PaperProtocol>,
+    pub paper: Option<PaperProtocol>,
     /// Mean LPIPS over the test images (absent without weights).
     #[serde(default)]
     pub lpips: Option<f64>,

@@ -14,8 +14,8 @@
 //! Runs without a probe (evaluated without images, or by an older version) are left out of
 //! the figures; an object none of whose runs has one gets none.
 
-use super::collect::{CollectSummary, CollectedRun};
 use super::plan::Purpose;
+use crate::collected::{CollectSummary, CollectedRun};
 use experiments::Result;
 use experiments::eval::probe;
 use report::RunOptions;

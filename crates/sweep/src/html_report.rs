@@ -17,7 +17,7 @@
 //! Images of the sweep (figures, the runs' renders and FLIP maps) are linked where they are,
 //! by relative paths; every link of every page is checked to exist before `collect` returns.
 
-use super::collect::{CollectSummary, CollectedRun};
+use crate::collected::{CollectSummary, CollectedRun};
 use experiments::{Error, Result};
 use report::html::{Page, check_well_formed, links};
 use report::paper::PaperComparison;
@@ -356,7 +356,7 @@ fn observed_png(
     summary: &mut CollectSummary,
 ) -> Result<Option<PathBuf>> {
     let Some(scene) = &r.config.scene else { return Ok(None) };
-    let Some((v, l)) = super::collect::parse_stem(stem) else { return Ok(None) };
+    let Some((v, l)) = crate::collected::parse_stem(stem) else { return Ok(None) };
     let exr = scene.join(format!("images/{}.exr", scene::sample_stem(v, l)));
     let path = report_dir.join("observed").join(format!("{}-{stem}.png", r.record.object));
     if path.is_file() {

@@ -6,6 +6,7 @@
 //! * [`execute`]: scene generation, shared LBO tables, runs in-process, as child processes
 //!   (`--jobs`) or as a job file for a cluster (`--emit-jobs`).
 //! * [`collect`](mod@collect): tables (Markdown + LaTeX) and figures (PNG) from any set of run directories.
+//! * [`collected`]: one evaluated run as `collect` reads it, and what `collect` wrote.
 //! * [`brdf_figures`]: the BRDF plots of `collect` (lit spheres, slices, albedo, validity).
 //! * [`html_report`]: the HTML report `collect` writes beside them.
 //! * [`heartbeat`]: plain progress lines when the output goes to a file.
@@ -26,6 +27,7 @@
 
 pub mod brdf_figures;
 pub mod collect;
+pub mod collected;
 pub mod execute;
 pub mod heartbeat;
 pub mod html_report;
@@ -33,6 +35,7 @@ pub mod plan;
 pub mod profile;
 pub mod sources;
 
-pub use collect::{CollectSummary, collect};
+pub use collect::collect;
+pub use collected::CollectSummary;
 pub use execute::{Execution, SweepSummary, exit_with_parent, run_one, sweep};
 pub use profile::{DEFAULT_PROFILE, SweepProfile};

@@ -151,6 +151,11 @@ struct RawProfile {
     sweep: SweepSection,
 }
 
+/// A profile that is not TOML of the expected shape, named with its origin.
+fn parse_error(origin: &str, e: impl std::fmt::Display) -> Error {
+    run_format::Error::ConfigParse { path: origin.into(), message: e.to_string() }.into()
+}
+
 /// An ablation group.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Ablation {
@@ -187,10 +192,8 @@ impl SweepProfile {
 
     /// Parses profile text; `origin` names it in errors.
     pub fn parse(text: &str, origin: &str) -> Result<Self> {
-        let raw: RawProfile = toml::from_str(text)
-            .map_err(|e| Error::ConfigParse { path: origin.into(), message: e.to_string() })?;
-        let run = toml::to_string(&raw.run)
-            .map_err(|e| Error::ConfigParse { path: origin.into(), message: e.to_string() })?;
+        let raw: RawProfile = toml::from_str(text).map_err(|e| parse_error(origin, e))?;
+        let run = toml::to_string(&raw.run).map_err(|e| parse_error(origin, e))?;
         let run = RunConfig::from_toml(&run, Path::new(&format!("{origin} [run]")))?;
         let p = SweepProfile {
             name: raw.name,

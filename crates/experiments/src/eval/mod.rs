@@ -201,7 +201,7 @@ pub fn eval_fitted(
         psnr: scores.model.psnr,
         dssim: scores.model.dssim,
         flip: scores.model.flip,
-        paper: scores.paper.map(|p| metric_settings::PaperProtocol {
+        paper: scores.paper.map(|p| run_format::test_metrics::PaperProtocol {
             scores: p,
             observed: scores.paper_observed,
             settings: metric_settings::PaperSettings::current(
