@@ -5,13 +5,14 @@
 //!   object mask against the observed images; the paper's: the whole frame against the
 //!   noise-free renders), FLIP error maps and the additive models' diffuse / specular / albedo
 //!   figures.
-//! * [`metric_settings`]: the exact settings of each protocol, written beside the scores.
+//! * [`metric_settings`] (run-format's): the exact settings of each protocol, written beside
+//!   the scores.
 //! * [`analyses`]: energy conservation and the reciprocity RMSE on the test records.
 //! * [`predict`](mod@predict): the model on CPU records, and as a [`metrics::BatchBrdf`].
 //! * [`probe`]: the model on the BRDF plots' fixed directions (lit sphere, slices, albedo
 //!   against angle, validity maps), stored as `<run>/probe.bin` when images are written.
 //! * [`fitted`]: a finished run opened for analysis (config, model, scene).
-//! * [`settings`]: the `[eval]` table of the run configuration.
+//! * [`run_format::eval_config`]: the `[eval]` table of the run configuration.
 //!
 //! The cube-root RMSE runs over the lit test samples with theta_l, theta_v <= 80 degrees, not
 //! saturated and with a valid ground truth (captured data has none: the RMSE is then absent).

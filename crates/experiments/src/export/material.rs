@@ -100,7 +100,7 @@ impl ExportedMaterial {
     /// Evaluates a finished parametric run at every vertex of its mesh.
     ///
     /// # Errors
-    /// [`Error::Config`] for a model that is not Disney or Torrance-Sparrow (their parameters
+    /// [`Error::Run`] (a configuration error) for a model that is not Disney or Torrance-Sparrow (their parameters
     /// have no renderer counterpart: use `export-merl`), or a non-finite parameter.
     pub fn from_run(fitted: &FittedRun) -> Result<Self> {
         let BrdfModel::Parametric(model) = &fitted.model else {

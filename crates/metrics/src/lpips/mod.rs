@@ -21,7 +21,8 @@ pub use net::Lpips;
 
 #[cfg(feature = "lpips")]
 /// The LPIPS of two sRGB images in [0, 1] with the weights at `path`, or
-/// [`Score::Unavailable`] ("weights missing") when the file does not exist.
+/// [`Score::Unavailable`](crate::aggregate::Score::Unavailable) ("weights missing") when the
+/// file does not exist.
 pub fn lpips_score(
     test: &crate::image::Image,
     reference: &crate::image::Image,
