@@ -169,7 +169,7 @@ enum Command {
         backend: Backend,
     },
     /// Import a DiLiGenT capture (`pmsData/<obj>PNG`, the ball) or a DiLiGenT-MV object
-    /// (`mvpmsData/<obj>PNG`) as a scene directory that `experiments fit` trains on.
+    /// (`mvpmsData/<obj>PNG`) as a scene directory that `fit` trains on.
     ImportDiligent {
         /// The object's directory (`.../pmsData/ballPNG` or `.../mvpmsData/bearPNG`).
         src: PathBuf,

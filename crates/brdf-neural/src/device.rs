@@ -2,7 +2,7 @@
 //!
 //! Models, batches and the tensor BRDFs take a [`Device`]; which backend runs them is decided
 //! here, from cargo features and, at run time, from [`Backend`] (parsed from the `--backend`
-//! flag of `experiments fit`/`eval` and `xtask reproduce-tables`).
+//! flag of `fit`/`eval` and `reproduce-tables`).
 //!
 //! | backend | `--backend` | cargo feature | default | notes |
 //! | --- | --- | --- | --- | --- |

@@ -205,7 +205,7 @@ pub fn run(command: RunCommand) -> Result<()> {
     Ok(())
 }
 
-/// `experiments fit`: the configuration from `--config` or the run directory, the scene from
+/// `fit`: the configuration from `--config` or the run directory, the scene from
 /// `--scene` when given; prints how the fit ended.
 fn fit_command(
     config: Option<PathBuf>,
