@@ -10,15 +10,24 @@
 //! Here k is cut into a number of blocks that depends on k alone (not on the thread count, so
 //! that a product's value is the same on every machine): each block is one single-threaded
 //! gemm into its own partial, the blocks run in parallel, and the partials are added in block
-//! order. The value differs from the unsplit product by f32 summation order only.
+//! order (in parallel over the output's elements). The value differs from the unsplit product
+//! by f32 summation order only.
+//!
+//! The blocks are 2,048 long, at most 32 of them: a batch of 2^15 gives 16 blocks, one for
+//! every core of a 16-core workstation, where the earlier 4,096-long blocks (8 at 2^15) left
+//! half of the cores idle in every weight gradient (313 GFLOP/s against 972 for a 2048^3
+//! product on a lent 16-core machine). One thread's rate on a 2,048-long block is its rate on
+//! a 4,096-long one; 1,024-long blocks cost 2 to 4 % of it (`benches/weight_gradient.rs`
+//! prints the rates by block length), and the two-core step by about as much.
 
 use alloc::vec;
 use alloc::vec::Vec;
 
-/// Inner-dimension length per block, below which a product is not split.
-const BLOCK_K: usize = 4096;
-/// At most this many blocks (bounds the partials' memory: `MAX_BLOCKS` m n floats).
-const MAX_BLOCKS: usize = 16;
+/// Inner-dimension length per block; a product shorter than two blocks is not split.
+const BLOCK_K: usize = 2048;
+/// At most this many blocks (bounds the partials' memory: `MAX_BLOCKS` m n floats, 8 MB for
+/// the largest output split).
+const MAX_BLOCKS: usize = 32;
 /// Outputs larger than this (256 x 256) keep gemm's own parallelism over rows and columns.
 const MAX_OUTPUT: usize = 256 * 256;
 
@@ -83,11 +92,50 @@ pub(crate) unsafe fn matmul_split_k(
     }
     // SAFETY: `out` holds m n elements, written above.
     let dst = unsafe { core::slice::from_raw_parts_mut(out, m * n) };
-    for p in &partials {
-        for (d, s) in dst.iter_mut().zip(p) {
-            *d += s;
+    add_partials(dst, &partials);
+}
+
+/// `dst[i] += partials[0][i] + ...`, one element's additions in block order; spread over the
+/// threads by chunks of elements, so the value does not depend on the thread count.
+fn add_partials(dst: &mut [f32], partials: &[Vec<f32>]) {
+    const CHUNK: usize = 2048;
+    let add = |c: usize, d: &mut [f32]| {
+        let (start, len) = (c * CHUNK, d.len());
+        for p in partials {
+            for (d, s) in d.iter_mut().zip(&p[start..start + len]) {
+                *d += s;
+            }
         }
+    };
+    #[cfg(feature = "rayon")]
+    if dst.len() > CHUNK && partials.len() > 1 {
+        use rayon::prelude::*;
+        dst.par_chunks_mut(CHUNK).enumerate().for_each(|(c, d)| add(c, d));
+        return;
     }
+    dst.chunks_mut(CHUNK).enumerate().for_each(|(c, d)| add(c, d));
+}
+
+/// [`matmul_split_k`] with a block count chosen by the caller, on row-major-or-strided
+/// operands: for `benches/weight_gradient.rs`, which compares block lengths on one machine.
+/// The product's value depends on `blocks`; the kernels' own choice is [`split_k_blocks`].
+///
+/// # Safety
+/// As [`crate::matmul`], with `1 <= blocks <= k`.
+#[doc(hidden)]
+pub unsafe fn matmul_in_blocks(
+    m: usize,
+    n: usize,
+    k: usize,
+    blocks: usize,
+    lhs: crate::MatRef,
+    rhs: crate::MatRef,
+    out: *mut f32,
+) {
+    assert!(blocks >= 1 && blocks <= k.max(1), "matmul_in_blocks: {blocks} blocks of k = {k}");
+    let op = |r: crate::MatRef| Operand { ptr: r.ptr, rs: r.rs, cs: r.cs };
+    // SAFETY: the caller's.
+    unsafe { matmul_split_k(m, n, k, blocks, op(lhs), op(rhs), out) }
 }
 
 /// dst (m x n, every element written) = lhs[.., k0..k1] x rhs[k0..k1, ..], one thread.
@@ -145,9 +193,10 @@ mod tests {
 
     #[test]
     fn blocks_depend_on_k_and_the_output_size_only() {
-        assert_eq!(split_k_blocks(128, 128, 32_768), 8);
-        assert_eq!(split_k_blocks(128, 128, 8_192), 2);
-        assert_eq!(split_k_blocks(128, 128, 8_191), 1);
+        assert_eq!(split_k_blocks(128, 128, 32_768), 16);
+        assert_eq!(split_k_blocks(128, 128, 8_192), 4);
+        assert_eq!(split_k_blocks(128, 128, 4_096), 2);
+        assert_eq!(split_k_blocks(128, 128, 4_095), 1);
         assert_eq!(split_k_blocks(128, 128, 1 << 20), MAX_BLOCKS);
         assert_eq!(split_k_blocks(512, 512, 32_768), 1);
         assert_eq!(split_k_blocks(32_768, 128, 128), 1);
@@ -156,7 +205,7 @@ mod tests {
 
     #[test]
     fn split_product_matches_f64_for_both_layouts_of_the_left_operand() {
-        let (m, n, k) = (7, 19, 9_001);
+        let (m, n, k) = (7, 19, 4_201);
         let a: Vec<f32> = (0..m * k).map(|i| ((i * 37 % 101) as f32 - 50.0) / 50.0).collect();
         let b: Vec<f32> = (0..k * n).map(|i| ((i * 53 % 89) as f32 - 44.0) / 44.0).collect();
         let want = reference(m, n, k, &a, &b);
@@ -172,6 +221,39 @@ mod tests {
             for (got, want) in out.iter().zip(&want) {
                 assert!((*got as f64 - want).abs() <= 1e-5 * k as f64, "{got} vs {want}");
             }
+        }
+    }
+
+    /// The partials of a product with more than one chunk of output are added on every thread;
+    /// the bits must not depend on how many there are.
+    #[cfg(feature = "rayon")]
+    #[test]
+    fn bits_do_not_depend_on_the_thread_count() {
+        let (m, n, k) = (70, 128, 40_000);
+        let a: Vec<f32> = (0..k * m).map(|i| ((i * 37 % 101) as f32 - 50.0) / 50.0).collect();
+        let b: Vec<f32> = (0..k * n).map(|i| ((i * 53 % 89) as f32 - 44.0) / 44.0).collect();
+        let blocks = split_k_blocks(m, n, k);
+        assert_eq!(blocks, 19);
+        let product = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let mut out = vec![f32::NAN; m * n];
+            let lhs = Operand { ptr: a.as_ptr(), rs: 1, cs: m as isize };
+            let rhs = Operand { ptr: b.as_ptr(), rs: n as isize, cs: 1 };
+            pool.install(|| unsafe { matmul_split_k(m, n, k, blocks, lhs, rhs, out.as_mut_ptr()) });
+            out
+        };
+        let one = product(1);
+        for threads in [2, 3, 7] {
+            let other = product(threads);
+            assert!(
+                one.iter().zip(&other).all(|(x, y)| x.to_bits() == y.to_bits()),
+                "{threads} threads"
+            );
+        }
+        let at: Vec<f32> = (0..m * k).map(|idx| a[(idx % k) * m + idx / k]).collect();
+        let want = reference(m, n, k, &at, &b);
+        for (got, want) in one.iter().zip(&want) {
+            assert!((*got as f64 - want).abs() <= 1e-5 * k as f64, "{got} vs {want}");
         }
     }
 }
