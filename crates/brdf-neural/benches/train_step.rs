@@ -11,10 +11,12 @@
 //! - `BRDF_BENCH_ALL_MODELS=1` adds the six other model kinds to the summary (their default
 //!   configurations; `docs/reproduce.md` sizes the `full` profile from these step times);
 //! - `BRDF_BENCH_PYTORCH=python3` (a Python with torch) also runs `benches/pytorch_step.py`,
-//!   the same Single MLP step in PyTorch on the same number of threads (on CUDA for the GPU
-//!   backends), back to back with ours: three rounds of 10 steps each side after warm-up, and
-//!   prints the ratios;
-//! - `BRDF_BENCH_MODELS=single_mlp,disney` times only these models (names as in the summary);
+//!   the same step in PyTorch for every model timed (`--kind`, the model rebuilt from
+//!   `neural_brdfs.reference_torch` in the same default configuration) on the same number of
+//!   threads (on CUDA for the GPU backends), back to back with ours: three rounds of 10 steps
+//!   each side after warm-up, and prints the ratios;
+//! - `BRDF_BENCH_MODELS=single_mlp,disney` times only these models (names as in the summary:
+//!   each kind's `config_name`);
 //!   `BRDF_BENCH_RATES=0` skips the gemm and product rates and prints nothing (for `perf`);
 //! - `BRDF_KEEP_MALLOC=0` turns the host-memory policy off (`brdf_neural::host_memory`);
 //! - `BRDF_BENCH_PRECISION=f32,bf16` (default `f32`) also times every step with bf16 matrix
@@ -85,8 +87,7 @@ fn configs() -> Vec<(&'static str, ModelConfig)> {
             if ![ModelKind::SingleMlp, ModelKind::AdditiveSharedEnhanced, ModelKind::Disney]
                 .contains(&kind)
             {
-                let name: &'static str = Box::leak(format!("{kind:?}").into_boxed_str());
-                out.push((name, ModelConfig::new(kind)));
+                out.push((kind.config_name(), ModelConfig::new(kind)));
             }
         }
     }
@@ -295,7 +296,7 @@ fn median_step(step: &mut Step, reps: usize) -> f64 {
 /// CPU on as many threads.
 fn pytorch_step(
     python: &str,
-    backend: Backend,
+    (backend, kind): (Backend, &str),
     n: usize,
     reps: usize,
     bf16: bool,
@@ -311,7 +312,7 @@ fn pytorch_step(
         Backend::Flex | Backend::NdArray => "cpu",
     };
     let out = std::process::Command::new(python)
-        .args([script, "--batch", &n.to_string(), "--threads", &threads])
+        .args([script, "--kind", kind, "--batch", &n.to_string(), "--threads", &threads])
         .args(["--reps", &reps.to_string(), "--machine", "--device", device])
         .args(if bf16 { &["--bf16"][..] } else { &[] })
         .output()
@@ -344,8 +345,7 @@ fn bench(cr: &mut Criterion) {
             let secs = median_step(&mut step, 7);
             let gflops = step_flops(&c, n) / secs / 1e9;
             summary.push((backend, precision, split, name, secs, gflops));
-            if name == "single_mlp"
-                && split == default_split(backend, n)
+            if split == default_split(backend, n)
                 && let Ok(python) = std::env::var("BRDF_BENCH_PYTORCH")
             {
                 // Back to back, three rounds: ours then PyTorch's, medians of 10 steps each.
@@ -357,14 +357,15 @@ fn bench(cr: &mut Criterion) {
                     let ours = median_step(&mut step, 10);
                     // A bf16 round also times PyTorch's f32 step right after its autocast one:
                     // the issue's target compares our step with PyTorch's f32 step.
-                    let theirs = pytorch_step(&python, backend, n, 10, bf16).and_then(|t| {
+                    let side = (backend, name);
+                    let theirs = pytorch_step(&python, side, n, 10, bf16).and_then(|t| {
                         let f32_step =
-                            if bf16 { pytorch_step(&python, backend, n, 10, false)? } else { t };
+                            if bf16 { pytorch_step(&python, side, n, 10, false)? } else { t };
                         Ok((t, f32_step))
                     });
                     match theirs {
                         Ok((theirs, theirs_f32)) => versus_pytorch
-                            .push((backend, precision, split, ours, theirs, theirs_f32)),
+                            .push((backend, precision, split, name, ours, theirs, theirs_f32)),
                         Err(e) => {
                             eprintln!("PyTorch baseline not run: {e}");
                             break;
@@ -441,18 +442,19 @@ fn bench(cr: &mut Criterion) {
         );
     }
     if !versus_pytorch.is_empty() {
-        println!("\nSingle MLP step, back to back with PyTorch (medians of 10 steps; bf16 against");
+        println!("\nThe step, back to back with PyTorch (medians of 10 steps; bf16 against");
         println!("PyTorch's bf16 autocast, then against PyTorch's f32 step timed right after it):");
         println!(
-            "| backend | precision | split | ours ms | PyTorch ms | ours / PyTorch | \
+            "| backend | precision | split | model | ours ms | PyTorch ms | ours / PyTorch | \
              PyTorch f32 ms | ours / PyTorch f32 |"
         );
-        println!("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |");
-        for (b, p, split, ours, theirs, theirs_f32) in versus_pytorch {
+        println!("| --- | --- | ---: | --- | ---: | ---: | ---: | ---: | ---: |");
+        for (b, p, split, name, ours, theirs, theirs_f32) in versus_pytorch {
             let (o, t, t32) = (ours * 1e3, theirs * 1e3, theirs_f32 * 1e3);
             let (ratio, ratio32) = (ours / theirs, ours / theirs_f32);
             println!(
-                "| {b:?} | {} | {split} | {o:.1} | {t:.1} | {ratio:.3} | {t32:.1} | {ratio32:.3} |",
+                "| {b:?} | {} | {split} | {name} | {o:.1} | {t:.1} | {ratio:.3} | {t32:.1} | \
+                 {ratio32:.3} |",
                 p.name()
             );
         }

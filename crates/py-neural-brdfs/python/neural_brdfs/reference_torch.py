@@ -1,23 +1,34 @@
-"""Reference PyTorch implementation of the neural BRDF models of ``brdf-neural``.
+"""Reference PyTorch implementation of the models of ``brdf-neural``: all nine kinds.
 
-The same models as :mod:`neural_brdfs.reference_numpy` (which documents the pipeline and reads
-the export), as ``torch.nn.Module`` subclasses whose ``state_dict`` names are the exported
-tensor names (``mlp.layers.0.weight``, ``trunk.skip.weight``, ``spatial.vertex_features``...),
-so a model can be fine-tuned, moved to a GPU or re-exported with PyTorch's own tools:
+The purely neural kinds (``single_mlp``, ``additive_separate``, ``additive_shared`` and their
+``_enhanced`` variants) are the models of :mod:`neural_brdfs.reference_numpy` (which documents
+the pipeline and reads the export); the parametric kinds (``rp``, ``ts``, ``disney``,
+``fmbrdf``: an MLP predicts the parameters of an analytic BRDF) live in
+:mod:`neural_brdfs.reference_torch_parametric` and are re-exported here. All are
+``torch.nn.Module`` subclasses of :class:`NeuralBrdf` whose ``state_dict`` names are the
+exported tensor names (``mlp.layers.0.weight``, ``trunk.skip.weight``, ``fm_alpha``,
+``spatial.vertex_features``...), so a model can be fine-tuned, moved to a GPU or re-exported
+with PyTorch's own tools:
 
->>> m = load("runs/spot/export", device="cuda")
+>>> m = load("runs/spot/export", device="cuda")               # any kind
 >>> f = m(m.spatial_features(triangle, barycentric), l, v)    # (n, 3) f_r, 1/sr
 >>> f = m.eval_points(triangle, barycentric, l, v)              # the same
+>>> x, d = m.prepare(spatial, l, v)   # once: what Rust computes on the CPU (no gradient)
+>>> f = m.forward_prepared(x, d)["f"]                           # the differentiable rest
 
 ``eval`` is also available with the signature of the numpy model when called with four
 arguments; with none it is ``nn.Module.eval`` (the models have no train/eval differences).
+FMBRDF needs its two fixed helper networks' weights (``load(..., fmbrdf_weights=...)``, by
+default ``$NEURAL_BRDF_FMBRDF_WEIGHTS`` or the package's copy).
 
 Directions are local-frame unit vectors (normal +z, ``l`` to the light, ``v`` to the viewer).
 The direction features are computed in float32 without gradient (in Rust they are inputs
 computed on the CPU), with ``atan2``, ``hypot``, ``sin`` and ``cos`` evaluated in float64 and
 rounded, as in the numpy module (in float32 on devices without float64, where a feature may
-differ by an ulp and, at an exact branch point such as ``phi_d`` near 0 / 2 pi, by a wrap). The networks run in the parameters' dtype (float32
-unless converted). This module is the only one of the package importing torch.
+differ by an ulp and, at an exact branch point such as ``phi_d`` near 0 / 2 pi, by a wrap);
+the parametric kinds' pair geometry likewise (float32, no gradient). The networks and the
+analytic BRDFs run in the parameters' dtype (float32 unless converted). This module and its
+parametric sibling are the only ones of the package importing torch.
 """
 
 from __future__ import annotations
@@ -32,8 +43,11 @@ try:
 except ImportError:  # a standalone copy next to reference_numpy.py
     import reference_numpy as _ref
 
+#: Defined in :mod:`neural_brdfs.reference_torch_parametric`, re-exported (lazily).
+_PARAMETRIC = ("ParametricBrdf", "PairGeometry", "pair_geometry", "FmbrdfNets",
+               "read_fmbrdf_weights", "default_fmbrdf_weights", "read_export")
 __all__ = ["load", "Mlp", "AngleFeatures", "SpatialTable", "NeuralBrdf", "SingleMlp",
-           "AdditiveSeparate", "AdditiveShared"]
+           "AdditiveSeparate", "AdditiveShared", *_PARAMETRIC]
 
 PI, TAU, FRAC_1_PI = float(_ref.PI_F32), float(_ref.TAU_F32), float(_ref.FRAC_1_PI_F32)
 
@@ -239,12 +253,18 @@ class SpatialTable(nn.Module):
 
 # -------------------------------------------------------------------------------------- models
 class NeuralBrdf(nn.Module):
-    """A fitted neural BRDF; subclasses hold the networks under their exported names."""
+    """A fitted model of any kind; subclasses hold the networks under their exported names.
+
+    ``forward_parts(spatial, l, v) = forward_prepared(*prepare(spatial, l, v))``: ``prepare``
+    does what Rust does on the CPU before the networks (checks, spatial NaN -> 0 and clamp,
+    the direction features), ``forward_prepared`` the differentiable rest."""
+
+    _mlp_specs = staticmethod(_ref.mlp_specs)
 
     def __init__(self, config: "_ref.ModelConfig", spatial: SpatialTable):
         super().__init__()
         self.config = config
-        self.specs = _ref.mlp_specs(config)
+        self.specs = self._mlp_specs(config)
         self.angle_features = AngleFeatures(config.angles)
         self.spatial = spatial
 
@@ -256,9 +276,14 @@ class NeuralBrdf(nn.Module):
         """Interpolated spatial rows ``(n, dim)`` float32 (see :class:`SpatialTable`)."""
         return self.spatial(triangle, barycentric)
 
-    def forward_parts(self, spatial, l, v):
-        """Every output as a dict: ``f`` and, for additive kinds, ``diffuse`` (with the
-        enhanced ``1 - xi``), ``diffuse_raw``, ``specular`` (and ``xi``); ``(n, 3)`` each."""
+    def direction_features(self, l, v):
+        """The direction inputs Rust computes on the CPU, without gradient: the encoded angle
+        features ``(n, d)`` float32 (parametric kinds: their ``PairGeometry``)."""
+        return self.angle_features(l, v)
+
+    def prepare(self, spatial, l, v):
+        """``(x, features)`` in the parameters' dtype and device: the checked spatial rows
+        (NaN -> 0, clamped into [-1e3, 1e3]; differentiable) and :meth:`direction_features`."""
         p = next(self.parameters())
         x = torch.as_tensor(spatial, device=p.device).to(torch.float32)
         if x.ndim != 2 or x.shape[1] != self.config.spatial_dim:
@@ -266,12 +291,22 @@ class NeuralBrdf(nn.Module):
                              f"got {tuple(x.shape)}")
         x = torch.where(torch.isnan(x), torch.zeros_like(x), x)
         x = x.clamp(-float(_ref.SPATIAL_LIMIT), float(_ref.SPATIAL_LIMIT))
-        l = torch.as_tensor(l, device=p.device)
-        v = torch.as_tensor(v, device=p.device)
-        ang = self.angle_features(l, v)
-        if ang.shape[0] != x.shape[0]:
-            raise ValueError(f"{x.shape[0]} spatial rows but {ang.shape[0]} direction pairs")
-        return self._network(x.to(p.dtype), ang.to(p.dtype))
+        d = self.direction_features(torch.as_tensor(l, device=p.device),
+                                    torch.as_tensor(v, device=p.device))
+        if len(d) != x.shape[0]:
+            raise ValueError(f"{x.shape[0]} spatial rows but {len(d)} direction pairs")
+        return x.to(p.dtype), d.to(p.dtype)
+
+    def forward_prepared(self, x, features):
+        """The outputs of :meth:`forward_parts` from the results of :meth:`prepare` (what a
+        training step computes; inputs already in the parameters' dtype and device)."""
+        return self._network(x, features)
+
+    def forward_parts(self, spatial, l, v):
+        """Every output as a dict: ``f`` and, for additive kinds, ``diffuse`` (with the
+        enhanced ``1 - xi``), ``diffuse_raw``, ``specular`` (and ``xi``); ``(n, 3)`` each;
+        for parametric kinds ``params`` (the BRDF parameters)."""
+        return self.forward_prepared(*self.prepare(spatial, l, v))
 
     def forward(self, spatial, l, v):
         """f_r ``(n, 3)`` (linear RGB, 1/sr) at spatial rows ``(n, dim)`` and local ``l, v``."""
@@ -336,10 +371,14 @@ _CLASSES = {"single_mlp": SingleMlp, "additive_separate": AdditiveSeparate,
             "additive_shared_enhanced": AdditiveShared}
 
 
-def load(folder, device=None, dtype=torch.float32) -> NeuralBrdf:
-    """Rebuilds the model of an export folder (checked by ``reference_numpy.read_export``)
-    with its parameters in ``dtype`` on ``device``."""
-    config, skind, tensors, _ = _ref.read_export(folder)
+def load(folder, device=None, dtype=torch.float32, fmbrdf_weights=None,
+         lambda_mode="dense") -> NeuralBrdf:
+    """Rebuilds the model of an export folder of any kind (checked by
+    ``reference_torch_parametric.read_export``) with its parameters in ``dtype`` on
+    ``device``. FMBRDF only: ``fmbrdf_weights`` (path, bytes or tensor dict; default
+    ``default_fmbrdf_weights()``) and the Lambda network's ``lambda_mode`` (``"dense"`` or
+    ``"segments"``)."""
+    config, skind, tensors, _ = _parametric().read_export(folder)
     vf = tensors.get("spatial.vertex_features")
     tr = tensors.get("spatial.triangles")
     spatial = SpatialTable(
@@ -348,7 +387,10 @@ def load(folder, device=None, dtype=torch.float32) -> NeuralBrdf:
         else torch.zeros((0, config.spatial_dim)),
         torch.from_numpy(tr.astype("int64")) if tr is not None
         else torch.zeros((0, 3), dtype=torch.int64))
-    model = _CLASSES[config.kind](config, spatial)
+    if config.kind in _ref.PARAMETRIC_KINDS:
+        model = _parametric().ParametricBrdf(config, spatial, fmbrdf_weights, lambda_mode)
+    else:
+        model = _CLASSES[config.kind](config, spatial)
     state = {k: torch.from_numpy(v) for k, v in tensors.items() if not k.startswith("spatial.")}
     state["spatial.vertex_features"] = spatial.vertex_features
     state["spatial.triangles"] = spatial.triangles
@@ -357,3 +399,19 @@ def load(folder, device=None, dtype=torch.float32) -> NeuralBrdf:
     if device is not None:
         model.to(device=device)
     return model.train(False)
+
+
+def _parametric():
+    try:
+        from . import reference_torch_parametric as par
+    except ImportError:  # a standalone copy
+        import reference_torch_parametric as par
+    return par
+
+
+def __getattr__(name):
+    """The parametric names of ``__all__``, from :mod:`reference_torch_parametric` (imported
+    on first use: it subclasses :class:`NeuralBrdf`)."""
+    if name in _PARAMETRIC:
+        return getattr(_parametric(), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
