@@ -14,6 +14,10 @@
 #   bash benches/device_gpu.sh eval      # evaluation's start-up, previous build against this one
 #   bash benches/device_gpu.sh loop      # the loop with losses read every step or every 100 steps,
 #                                        # SM use, and the warm-up with a persistent GPU cache
+#   bash benches/device_gpu.sh cpu       # the many-core CPU: the flex step of all 9 kinds against
+#                                        # PyTorch on as many threads, the weight gradients' split
+#   bash benches/device_gpu.sh kinds     # the wgpu step of all 9 kinds against PyTorch's step of
+#                                        # each kind on CUDA: eager f32, TF32, a CUDA graph
 #
 # With autotune on (the wgpu feature), the first use of every matrix-product shape in a process
 # is benchmarked, and the first process on a fresh machine also compiles every kernel and runs
@@ -30,7 +34,7 @@
 #   5. where a step's GPU time goes: CubeCL's kernel profile of Single MLP steps, summed by kernel;
 #   6. the step on the machine's CPU cores (flex), without and with the batch split.
 # `final`: the correctness test with minimal autotune, all 9 kinds' steps at the trainer's
-# split against PyTorch, and three models end to end on the default run's scene.
+# split (against PyTorch in `kinds`), and three models end to end on the default run's scene.
 # `paper`: all 9 models on one scene of the `full` profile (512 px, batch 2^15): the real
 # training loop's samples/s after a warm-up, the validation pass, the evaluation at 512 px; then
 # the default run's Single MLP for its converged CPU fit's steps; the GPU's use, sampled.
@@ -120,9 +124,9 @@ if [ "$STAGE" = final ]; then
     # shape slow: the all-model bench with two splits outlasted its limit there).
     step "wgpu against the CPU on this GPU (autotune minimal)"
     run 90 gpu_backend.log env CUBECL_AUTOTUNE_LEVEL=minimal $B/gpu_backend --test-threads=1
-    step "training step, wgpu, the trainer's split (64 parts), all 9 kinds, against PyTorch"
+    step "training step, wgpu, the trainer's split (64 parts), all 9 kinds (PyTorch: \`kinds\`)"
     run 170 step_wgpu.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_ALL_MODELS=1 BRDF_BENCH_BACKENDS=wgpu \
-        BRDF_BENCH_PYTORCH=python3 $B/train_step --bench
+        $B/train_step --bench
     step "end to end on wgpu: $STEPS steps, three models, then evaluation"
     run 50 default_scenes.log $B/profile_steps --prepare default /tmp/default
     run 130 profile_wgpu.log $B/profile_steps /tmp/default spot__blue-acrylic "$STEPS" wgpu \
@@ -236,6 +240,44 @@ if [ "$STAGE" = loop ]; then
         done
     done
     kill $DMON
+fi
+if [ "$STAGE" = kinds ]; then
+    # Item 1 of the throughput issue: every kind's step (batch 2^15, the trainer's split) back
+    # to back with PyTorch's step of the same kind (`benches/pytorch_step.py --kind`, rebuilt
+    # from `neural_brdfs.reference_torch`), eager f32 with TF32 off, three rounds; then
+    # PyTorch alone with TF32 and with the step captured in a CUDA graph (the stretch target).
+    # One call: DEVICE_DEADLINE=560 bash benches/device_gpu.sh kinds
+    export PYTHONPATH=$PWD/crates/py-neural-brdfs/python${PYTHONPATH:+:$PYTHONPATH}
+    python3 -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name(0))"
+    step "the wgpu step, all 9 kinds, against PyTorch eager f32 on CUDA"
+    run 380 step_kinds.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_ALL_MODELS=1 BRDF_BENCH_BACKENDS=wgpu \
+        BRDF_BENCH_RATES=1 BRDF_BENCH_PYTORCH=python3 $B/train_step --bench
+    step "PyTorch alone: TF32, then a CUDA graph (f32), all 9 kinds"
+    run 60 torch_tf32.log python3 benches/pytorch_step.py --kind all --device cuda --tf32 --reps 30
+    run 60 torch_graph.log python3 benches/pytorch_step.py --kind all --device cuda --cuda-graph \
+        --reps 30
+fi
+if [ "$STAGE" = cpu ]; then
+    # Item 5 of the throughput issue: the f32 step on all the machine's cores against PyTorch
+    # on as many threads (`benches/pytorch_step.py --kind`, the model rebuilt from
+    # `neural_brdfs.reference_torch`), back to back, every kind; then the same on two cores
+    # (`taskset`), the development machine's count. Before the steps, the weight-gradient
+    # products alone (`benches/weight_gradient.rs`): the kernels' split (32 blocks of k at
+    # 2^15) against gemm over the output and against 8, 16 and 64 blocks, on all threads and
+    # on one. No GPU is used. The package's Python sources come from the checkout.
+    export PYTHONPATH=$PWD/crates/py-neural-brdfs/python${PYTHONPATH:+:$PYTHONPATH}
+    lscpu | grep -E "Model name|^CPU\(s\)|Thread|Flags" | cut -c1-300
+    step "weight gradients: all threads, then one"
+    run 60 wgrad_all.log env CPU_KERNELS_BENCH_BATCH=32768 $B/weight_gradient --bench '^$'
+    run 60 wgrad_one.log env CPU_KERNELS_BENCH_BATCH=32768 RAYON_NUM_THREADS=1 \
+        $B/weight_gradient --bench '^$'
+    step "the f32 step on all cores, all 9 kinds, against PyTorch on as many threads"
+    run 300 step_cpu_all.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_ALL_MODELS=1 \
+        BRDF_BENCH_BACKENDS=flex BRDF_BENCH_PYTORCH=python3 $B/train_step --bench
+    step "the same on two cores, Single MLP and Disney"
+    run 120 step_cpu_two.log env RAYON_NUM_THREADS=2 BRDF_BENCH_QUICK=1 \
+        BRDF_BENCH_MODELS=single_mlp,disney BRDF_BENCH_BACKENDS=flex BRDF_BENCH_PYTORCH=python3 \
+        taskset -c 0,1 $B/train_step --bench
 fi
 step "done"
 tar -czf "$OUT/$STAGE.tar.gz" -C "$LOGS" .

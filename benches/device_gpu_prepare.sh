@@ -20,12 +20,15 @@ fi
 # (`--prepare`), so no xtask travels.
 cargo build --release -p sweep -p brdf-neural --features sweep/wgpu \
     --example profile_steps --bench train_step --test gpu_backend
+# The weight-gradient products alone (the `cpu` stage), without wgpu.
+cargo build --release -p cpu-kernels --bench weight_gradient
 
 newest() { find target/release/deps -maxdepth 1 -type f -executable -name "$1-*" -printf '%T@ %p\n' | sort -n | tail -1 | cut -d' ' -f2; }
 rm -rf $R && mkdir -p $R/bin
 cp target/release/examples/profile_steps $R/bin/
 cp "$(newest train_step)" $R/bin/train_step
 cp "$(newest gpu_backend)" $R/bin/gpu_backend
+cp "$(newest weight_gradient)" $R/bin/weight_gradient
 strip $R/bin/*
 tar -cJf $R/bin.tar.xz -C $R bin
 rm -rf $R/bin
