@@ -8,7 +8,8 @@
 //! (each block is one single-threaded gemm). Environment: `CPU_KERNELS_BENCH_BATCH` (default
 //! 32768 and 8192). A summary line per shape gives GFLOP/s (2 m n k per product), and a second
 //! line the rates of the product cut into 8, 16, 32 and 64 blocks of k (4,096- to 512-long at
-//! 2^15), whatever the kernels' own choice.
+//! 2^15), whatever the kernels' own choice. Before them, the input gradients `dY Wᵀ` of the
+//! same layers through gemm's own threading against blocks of rows (the kernels' path).
 
 use cpu_kernels::{MatRef, Precision};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
@@ -104,9 +105,47 @@ fn bench(c: &mut Criterion) {
     }
 }
 
+/// The input gradients `dY Wᵀ` (and the bias-free skip products) of the same layers: a tall
+/// [k, n] x [n, m] product, through gemm's own parallelism against blocks of rows (each a
+/// single-threaded gemm, the blocks on every thread), which give the same bits.
+fn input_gradients() {
+    let threads = rayon::current_num_threads();
+    for k in batches() {
+        for (m, n) in [(128, 128), (316, 128), (188, 128)] {
+            // dY: k x n; W: n x m, the first n m of the second k x m operand (row-major).
+            let (dy, w) = operands(n, m, k);
+            let mut a = vec![0f32; k * m];
+            let mut b = vec![0f32; k * m];
+            let lhs = MatRef { ptr: dy.as_ptr(), rs: n as isize, cs: 1 };
+            let rhs = MatRef { ptr: w.as_ptr(), rs: m as isize, cs: 1 };
+            let flop = 2.0 * (m * n * k) as f64;
+            // SAFETY: dy holds k n floats, w at least n m, a and b k m.
+            let plain = median_seconds(|| unsafe {
+                cpu_kernels::gemm_f32::gemm(k, m, n, lhs, rhs, a.as_mut_ptr())
+            });
+            let rows = median_seconds(|| unsafe {
+                cpu_kernels::gemm_f32::gemm_by_rows(k, m, n, lhs, rhs, None, b.as_mut_ptr())
+            });
+            assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()), "same bits");
+            println!(
+                "input gradient [{k}, {n}] x [{n}, {m}], {threads} threads: gemm over the output \
+                 {:.1} GFLOP/s, blocks of rows {:.1} GFLOP/s, ratio {:.2}",
+                flop / plain * 1e-9,
+                flop / rows * 1e-9,
+                rows / plain
+            );
+        }
+    }
+}
+
+fn products(c: &mut Criterion) {
+    input_gradients();
+    bench(c);
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = bench
+    targets = products
 }
 criterion_main!(benches);

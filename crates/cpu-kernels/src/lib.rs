@@ -9,7 +9,7 @@
 //! | --- | --- | --- |
 //! | bf16 operands, f32 sums (AMX tiles, else `vdpbf16ps`, else emulated) | [`Precision::Bf16`], n >= 16, k >= 8, m n k >= 2^18 | [`bf16dot`], [`amx`] |
 //! | f32, k summed in blocks in parallel | a long k (>= 8,192) into a small output (<= 256 x 256): weight gradients | [`split_k`] |
-//! | f32 gemm in blocks of rows, bias added while the block is in cache | a bias, n >= 16 | [`gemm_f32`] |
+//! | f32 gemm in blocks of rows on every thread, bias added while the block is in cache | a bias, or at least two blocks of rows (2,048 rows at 128 columns); n >= 16 | [`gemm_f32`] |
 //! | f32 gemm (the `gemm` crate, as burn-flex calls it) | everything else | [`gemm_f32`] |
 //!
 //! A product's value depends on its operands, shape and precision only, never on the thread
@@ -92,19 +92,16 @@ pub unsafe fn matmul(
         }
         return;
     }
-    match bias {
+    if n >= 16 && k > 0 && (bias.is_some() || gemm_f32::row_blocks(m, n) >= 2) {
         // SAFETY: the caller's contract, which is the kernel's.
-        Some(b) if n >= 16 && k > 0 => unsafe {
-            gemm_f32::gemm_bias_by_rows(m, n, k, lhs, rhs, b, out)
-        },
-        _ => {
-            // SAFETY: the caller's contract, which is the kernel's.
-            unsafe { gemm_f32::gemm(m, n, k, lhs, rhs, out) };
-            if let Some(b) = bias {
-                // SAFETY: `out` holds the m x n product just written.
-                unsafe { bf16dot::add_bias_rows(m, n, out, b) };
-            }
-        }
+        unsafe { gemm_f32::gemm_by_rows(m, n, k, lhs, rhs, bias, out) };
+        return;
+    }
+    // SAFETY: the caller's contract, which is the kernel's.
+    unsafe { gemm_f32::gemm(m, n, k, lhs, rhs, out) };
+    if let Some(b) = bias {
+        // SAFETY: `out` holds the m x n product just written.
+        unsafe { bf16dot::add_bias_rows(m, n, out, b) };
     }
 }
 
