@@ -2,9 +2,13 @@
 # Builds what `benches/device_gpu.sh` runs on a lent GPU machine and puts it in `.devrun/` (and
 # the Vulkan loader's packages in `.gl/`), both ignored through .git/info/exclude. Run from the
 # checkout's root on the development machine; then carry `.devrun` and `.gl` with the call.
+# `DEVICE_FEATURES=sweep/vulkan DEVICE_BIN=.devrun_vk bash benches/device_gpu_prepare.sh` builds
+# the same binaries with wgpu's SPIR-V compiler (the `vulkan` feature) into `.devrun_vk/`, which
+# the `vulkan` stage of device_gpu.sh compares with the WGSL build.
 set -euo pipefail
-R=.devrun
-grep -qx '/.devrun/' .git/info/exclude || echo /.devrun/ >>.git/info/exclude
+R=${DEVICE_BIN:-.devrun}
+FEATURES=${DEVICE_FEATURES:-sweep/wgpu}
+grep -qx "/$R/" .git/info/exclude || echo "/$R/" >>.git/info/exclude
 grep -qx '/.gl/' .git/info/exclude || echo /.gl/ >>.git/info/exclude
 if [ ! -d .gl ]; then
     mkdir -p .gl /tmp/amd64/partial
@@ -18,7 +22,7 @@ fi
 # The example, the bench and the test in one build, one feature set (their dev-dependencies
 # join it; the bench profile is the release profile); the example also makes the scenes there
 # (`--prepare`), so no xtask travels.
-cargo build --release -p sweep -p brdf-neural --features sweep/wgpu \
+cargo build --release -p sweep -p brdf-neural --features "$FEATURES" \
     --example profile_steps --bench train_step --test gpu_backend
 # The weight-gradient products alone (the `cpu` stage), without wgpu.
 cargo build --release -p cpu-kernels --bench weight_gradient
