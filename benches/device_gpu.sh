@@ -18,8 +18,6 @@
 #                                        # PyTorch on as many threads, the weight gradients' split
 #   bash benches/device_gpu.sh kinds     # the wgpu step of all 9 kinds against PyTorch's step of
 #                                        # each kind on CUDA: eager f32, TF32, a CUDA graph
-#   bash benches/device_gpu.sh vulkan    # wgpu's SPIR-V compiler (`.devrun_vk`, carried) against
-#                                        # WGSL: the step, and a fit's start in a second process
 #
 # With autotune on (the wgpu feature), the first use of every matrix-product shape in a process
 # is benchmarked, and the first process on a fresh machine also compiles every kernel and runs
@@ -258,31 +256,6 @@ if [ "$STAGE" = kinds ]; then
     run 60 torch_tf32.log python3 benches/pytorch_step.py --kind all --device cuda --tf32 --reps 30
     run 60 torch_graph.log python3 benches/pytorch_step.py --kind all --device cuda --cuda-graph \
         --reps 30
-fi
-if [ "$STAGE" = vulkan ]; then
-    # Items 1 and 4 of the throughput issue: the same binaries built with the `vulkan` feature
-    # (CubeCL's SPIR-V compiler on Vulkan adapters: cooperative-matrix instructions where the
-    # driver has them, compiled pipelines kept in the persistent cache), carried as
-    # `.devrun_vk/bin.tar.xz` (see device_gpu_prepare.sh). The step of three kinds, WGSL then
-    # SPIR-V; then the default run's Single MLP fitted in two processes per build, each build
-    # on a fresh persistent cache: the second process's warm-up is the start-up left once
-    # autotune and compilation are cached (the target: training within 5 s).
-    mkdir -p /tmp/vk && tar -xJf .devrun_vk/bin.tar.xz -C /tmp/vk
-    step "the step: WGSL, then SPIR-V"
-    run 120 step_wgsl.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_BACKENDS=wgpu $B/train_step --bench
-    run 120 step_spirv.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_BACKENDS=wgpu \
-        /tmp/vk/bin/train_step --bench
-    run 60 default_scenes.log $B/profile_steps --prepare default /tmp/default
-    export PROFILE_WARMUP_STEPS=50 PROFILE_EVAL=none
-    for build in wgsl spirv; do
-        exe=$B/profile_steps
-        [ $build = spirv ] && exe=/tmp/vk/bin/profile_steps
-        export NEURAL_BRDF_GPU_CACHE=/tmp/gpu-cache-$build
-        rm -rf "$NEURAL_BRDF_GPU_CACHE"
-        for proc in 1 2; do
-            run 70 "start_${build}_$proc.log" $exe /tmp/default spot__blue-acrylic 200 wgpu SingleMlp
-        done
-    done
 fi
 if [ "$STAGE" = cpu ]; then
     # Item 5 of the throughput issue: the f32 step on all the machine's cores against PyTorch

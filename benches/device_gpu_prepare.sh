@@ -2,9 +2,9 @@
 # Builds what `benches/device_gpu.sh` runs on a lent GPU machine and puts it in `.devrun/` (and
 # the Vulkan loader's packages in `.gl/`), both ignored through .git/info/exclude. Run from the
 # checkout's root on the development machine; then carry `.devrun` and `.gl` with the call.
-# `DEVICE_FEATURES=sweep/vulkan DEVICE_BIN=.devrun_vk bash benches/device_gpu_prepare.sh` builds
-# the same binaries with wgpu's SPIR-V compiler (the `vulkan` feature) into `.devrun_vk/`, which
-# the `vulkan` stage of device_gpu.sh compares with the WGSL build.
+# `DEVICE_FEATURES=sweep/cuda DEVICE_BIN=.devrun_cuda bash benches/device_gpu_prepare.sh` builds
+# the same binaries with other features into another folder (carried as `.devrun_old` is, for a
+# comparison of two builds).
 set -euo pipefail
 R=${DEVICE_BIN:-.devrun}
 FEATURES=${DEVICE_FEATURES:-sweep/wgpu}
