@@ -61,12 +61,36 @@ pub fn save(
         let json = serde_json::to_string(state).map_err(|e| Error::format(tmp, e.to_string()))?;
         std::fs::write(tmp.join(STATE), json).map_err(|e| Error::io(tmp.join(STATE), e))
     })?;
-    for old in list(run)? {
-        if old.0 != state.step {
-            let _ = std::fs::remove_dir_all(&old.1);
-        }
-    }
+    remove_all_but(run, state.step)?;
     Ok(dir)
+}
+
+/// Removes every checkpoint folder of `run` but that of step `keep`, complete or not. Each is
+/// first renamed to a temporary name (one atomic step) and then deleted, so a kill midway
+/// leaves whole checkpoints or temporaries (which the next [`stdx::lock::DirLock`] removes),
+/// never a half-deleted folder. A run resumed after a kill between a checkpoint's write and
+/// this removal calls it again, so that it ends with the files of an uninterrupted run.
+pub fn remove_all_but(run: &RunDir, keep: u64) -> Result<()> {
+    let root = run.checkpoints();
+    let entries = match std::fs::read_dir(&root) {
+        Ok(e) => e,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(Error::io(&root, e)),
+    };
+    for entry in entries {
+        let entry = entry.map_err(|e| Error::io(&root, e))?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let Some(step) = name.strip_prefix("step-").and_then(|s| s.parse::<u64>().ok()) else {
+            continue;
+        };
+        if step == keep {
+            continue;
+        }
+        let aside = root.join(format!(".{name}.partial-removed-{}", std::process::id()));
+        std::fs::rename(entry.path(), &aside).map_err(|e| Error::io(entry.path(), e))?;
+        std::fs::remove_dir_all(&aside).map_err(|e| Error::io(&aside, e))?;
+    }
+    Ok(())
 }
 
 /// Adam's state as a burnpack with its tensors in name order. burn lists them in the order of

@@ -224,6 +224,10 @@ pub fn fit_and_keep(
         );
     }
     let dir = RunDir::new(run);
+    // A kill between a checkpoint's write and the removal of the older ones leaves them.
+    if let Some((step, _)) = checkpoint::list(&dir)?.pop() {
+        checkpoint::remove_all_but(&dir, step)?;
+    }
     if let Some(metrics) = prepare_run_dir(config, &dir, options.config_from_run_dir)? {
         return Ok((FitOutcome::AlreadyFinished(metrics), None));
     }

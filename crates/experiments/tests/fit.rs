@@ -212,7 +212,25 @@ fn runs_are_deterministic_and_resume_is_exact() {
     assert_eq!(losses(&a), losses(&b));
     let stop = FitOptions { stop_after: Some(30), ..Default::default() };
     assert_eq!(fit(&c, &r, stop).unwrap(), FitOutcome::Stopped(30));
+    // What a kill between a checkpoint's write and the removal of the older ones leaves: an
+    // older complete checkpoint and a half-removed one. The resumed run removes both.
+    let ckpt = |run: &Path, step: u32| run.join(format!("checkpoints/step-{step:09}"));
+    std::fs::create_dir_all(ckpt(&r, 20)).unwrap();
+    for f in ["model.bpk", "optim.bpk", "state.json"] {
+        std::fs::copy(ckpt(&r, 30).join(f), ckpt(&r, 20).join(f)).unwrap();
+    }
+    std::fs::create_dir_all(ckpt(&r, 10)).unwrap();
+    std::fs::copy(ckpt(&r, 30).join("model.bpk"), ckpt(&r, 10).join("model.bpk")).unwrap();
     let out = fit(&c, &r, FitOptions::default()).unwrap();
+    let checkpoints = |run: &Path| -> Vec<String> {
+        let d = std::fs::read_dir(run.join("checkpoints")).unwrap();
+        let mut names: Vec<String> =
+            d.map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        names.sort();
+        names
+    };
+    assert_eq!(checkpoints(&r), checkpoints(&a), "the resumed run keeps other checkpoints");
+    assert_eq!(checkpoints(&a), ["step-000000060"]);
     assert!(matches!(out, FitOutcome::Finished { resumed_from: 30, .. }), "{out:?}");
     assert_eq!(losses(&a), losses(&r));
     let curve = |run: &Path| std::fs::read_to_string(RunDir::new(run).curve()).unwrap();
