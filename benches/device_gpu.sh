@@ -18,6 +18,8 @@
 #                                        # PyTorch on as many threads, the weight gradients' split
 #   bash benches/device_gpu.sh kinds     # the wgpu step of all 9 kinds against PyTorch's step of
 #                                        # each kind on CUDA: eager f32, TF32, a CUDA graph
+#   bash benches/device_gpu.sh linear    # the linear layers on gpu-kernels against burn's:
+#                                        # correctness, all 9 kinds' steps, the training loop
 #
 # With autotune on (the wgpu feature), the first use of every matrix-product shape in a process
 # is benchmarked, and the first process on a fresh machine also compiles every kernel and runs
@@ -278,6 +280,39 @@ if [ "$STAGE" = cpu ]; then
     run 120 step_cpu_two.log env RAYON_NUM_THREADS=2 BRDF_BENCH_QUICK=1 \
         BRDF_BENCH_MODELS=single_mlp,disney BRDF_BENCH_BACKENDS=flex BRDF_BENCH_PYTORCH=python3 \
         taskset -c 0,1 $B/train_step --bench
+fi
+if [ "$STAGE" = linear ]; then
+    # The linear layers on this workspace's GPU kernels (`gpu-kernels`, NEURAL_BRDF_GPU_LINEAR=
+    # ours: the bias fused into a tiled product, split-K inside the weight gradient) against
+    # burn's (CubeCL's autotuned product, the trainer's batch split): first the wgpu tests
+    # against the CPU on our kernels; then every kind's step at batch 2^15, burn's kernels and
+    # ours alternated twice, with PyTorch eager f32 (TF32 off) in the same process as the
+    # reference; then the default run's Single MLP for 1,400 steps on each, `nvidia-smi dmon`
+    # sampling the SM use. One call: DEVICE_DEADLINE=560 bash benches/device_gpu.sh linear
+    export PYTHONPATH=$PWD/crates/py-neural-brdfs/python${PYTHONPATH:+:$PYTHONPATH}
+    step "wgpu against the CPU on this GPU, the linear layers on gpu-kernels"
+    run 90 gpu_backend_ours.log env NEURAL_BRDF_GPU_LINEAR=ours CUBECL_AUTOTUNE_LEVEL=minimal \
+        $B/gpu_backend --test-threads=1
+    for round in 1 2; do
+        for kernels in burn ours; do
+            step "the wgpu step, all 9 kinds, linear layers on $kernels (round $round)"
+            py=()
+            [ "$round" = 1 ] && [ "$kernels" = burn ] && py=(BRDF_BENCH_PYTORCH=python3)
+            run 110 "step_${kernels}_r$round.log" env NEURAL_BRDF_GPU_LINEAR=$kernels \
+                BRDF_BENCH_QUICK=1 BRDF_BENCH_ALL_MODELS=1 BRDF_BENCH_BACKENDS=wgpu \
+                BRDF_BENCH_RATES=1 "${py[@]}" $B/train_step --bench
+        done
+    done
+    export PROFILE_WARMUP_STEPS=50 PROFILE_EVAL=none
+    run 40 default_scenes.log $B/profile_steps --prepare default /tmp/default
+    nvidia-smi dmon -s u -d 1 -o T >"$LOGS/gpu_use.log" 2>&1 &
+    DMON=$!
+    for kernels in burn ours; do
+        echo "== $(date +%T) kernels $kernels" >>"$LOGS/gpu_use.log"
+        run 60 "loop_$kernels.log" env NEURAL_BRDF_GPU_LINEAR=$kernels $B/profile_steps \
+            /tmp/default spot__blue-acrylic 1400 wgpu SingleMlp
+    done
+    kill $DMON
 fi
 step "done"
 tar -czf "$OUT/$STAGE.tar.gz" -C "$LOGS" .

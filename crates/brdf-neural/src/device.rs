@@ -131,6 +131,7 @@ impl Backend {
             Backend::Wgpu => {
                 #[cfg(feature = "wgpu")]
                 {
+                    crate::gpu_linear::GpuLinear::from_env()?;
                     crate::gpu_cache::configure();
                     return Ok(Device::wgpu(Default::default()));
                 }
@@ -148,6 +149,7 @@ impl Backend {
                                 .into(),
                         ));
                     }
+                    crate::gpu_linear::GpuLinear::from_env()?;
                     crate::gpu_cache::configure();
                     return Ok(Device::cuda(0usize));
                 }

@@ -22,6 +22,10 @@ pub enum Error {
     /// A GPU backend that is built in but cannot run here (no driver).
     #[error("backend {0} cannot run here: {1}")]
     BackendUnavailable(Backend, String),
+    /// A setting (an environment variable) with a value this crate does not know; the message
+    /// names the variable and the values it takes.
+    #[error("{0}")]
+    Setting(String),
     /// Sample arrays whose lengths disagree.
     #[error("batch shape: {0}")]
     BatchShape(String),

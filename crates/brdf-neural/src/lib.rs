@@ -68,10 +68,13 @@ pub mod device;
 mod error;
 // The direction features, defined in model-spec, under their old path.
 pub use model_spec::features;
+#[cfg(any(feature = "wgpu", feature = "cuda"))]
+mod cube_linear;
 pub mod finite_check;
 #[cfg(feature = "flex")]
 mod flex_linear;
 pub mod gpu_cache;
+pub mod gpu_linear;
 pub mod host_memory;
 pub mod linear_op;
 pub mod mlp;

@@ -1,7 +1,9 @@
 //! The models' linear layers, `y = x W + b`, as a burn backend extension ([`LinearKernels`]):
 //! on the flex CPU backend the three products of a layer (forward, input gradient, weight
 //! gradient) run on this workspace's kernels (`cpu-kernels`, through the private module
-//! `flex_linear`); on every other backend [`linear`] is burn's own `linear`.
+//! `flex_linear`); on a GPU they run on `gpu-kernels` (through `cube_linear`) where
+//! [`crate::gpu_linear`] says so, else, as on every other backend, [`linear`] is burn's own
+//! `linear`.
 //!
 //! burn's extension mechanism (`#[backend_extension]`) routes the operation through burn's
 //! dispatch layer to the backend that holds the tensors, so burn itself stays unpatched. Its
@@ -15,7 +17,7 @@
 
 use crate::precision::MatmulPrecision;
 use burn::tensor::Tensor;
-#[cfg(feature = "flex")]
+#[cfg(any(feature = "flex", feature = "wgpu", feature = "cuda"))]
 pub use kernels::LinearKernels;
 
 /// `x W + b` for x `[rows, d_in]`, W `[d_in, d_out]`, b `[d_out]`, its products in `precision`
@@ -31,8 +33,23 @@ pub fn linear(
     if x.device().inner() == burn::tensor::Device::flex() {
         return kernels::linear(x, weight, bias, precision);
     }
+    #[cfg(any(feature = "wgpu", feature = "cuda"))]
+    if uses_gpu_kernels(&x) {
+        return kernels::linear(x, weight, bias, precision);
+    }
     let _ = precision;
     burn::tensor::module::linear(x, weight, bias)
+}
+
+/// Whether `x` is on a GPU (CubeCL) device whose linear layers run on this workspace's
+/// `gpu-kernels` ([`crate::gpu_linear`], `NEURAL_BRDF_GPU_LINEAR=ours`).
+pub fn uses_gpu_kernels(x: &Tensor<2>) -> bool {
+    #[cfg(any(feature = "wgpu", feature = "cuda"))]
+    if crate::gpu_linear::GpuLinear::current() == crate::gpu_linear::GpuLinear::Ours {
+        return matches!(x.device().inner().as_dispatch(), burn::backend::DispatchDevice::Cube(_));
+    }
+    let _ = x;
+    false
 }
 
 /// `max(x, 0)`, its backward pass on this workspace's kernels on the flex backend (the mask
@@ -45,5 +62,5 @@ pub fn relu(x: Tensor<2>) -> Tensor<2> {
     burn::tensor::activation::relu(x)
 }
 
-#[cfg(feature = "flex")]
+#[cfg(any(feature = "flex", feature = "wgpu", feature = "cuda"))]
 mod kernels;

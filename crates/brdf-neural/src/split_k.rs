@@ -66,7 +66,9 @@ impl Drop for BatchSplitGuard {
 pub(crate) fn linear(layer: &Linear, x: Tensor<2>) -> Tensor<2> {
     let parts = parts();
     let [rows, d_in] = x.dims();
-    if parts <= 1 || !rows.is_multiple_of(parts) || rows / parts < MIN_ROWS {
+    // The gpu-kernels split the weight gradients inside their own kernel.
+    let own_kernels = crate::linear_op::uses_gpu_kernels(&x);
+    if parts <= 1 || !rows.is_multiple_of(parts) || rows / parts < MIN_ROWS || own_kernels {
         // The weight first: lazily initialised parameters draw their values at their first
         // `val()`, in the order burn's `Linear::forward` reads them.
         let weight = layer.weight.val();

@@ -17,6 +17,10 @@
 //! Adam steps on both backends from the same start must follow the same loss curve to 1e-3, on
 //! the GPU also with its linear layers' batch split into parts as the trainer does there
 //! ([`brdf_neural::split_k`]).
+//!
+//! `NEURAL_BRDF_GPU_LINEAR=ours` runs the whole file with the linear layers on this workspace's
+//! `gpu-kernels` instead of burn's ([`brdf_neural::gpu_linear`]); a test checks that the layers
+//! take the kernels the variable names.
 #![cfg(any(feature = "wgpu", feature = "cuda"))]
 
 mod common;
@@ -141,6 +145,18 @@ fn the_split_k_trains_along_the_same_loss_curve_on_the_gpu() {
     // Two parts of 256 rows each: the split path (split_k::MIN_ROWS).
     let (l_cpu, l_gpu, _) = loss_curves(&c, &curve_data(&c, 9), 6, 2);
     assert_close(&l_gpu, &l_cpu, 1e-3, "loss curve with the batch split");
+}
+
+/// The linear layers take the kernels `NEURAL_BRDF_GPU_LINEAR` names: `gpu-kernels` for
+/// `ours` on a GPU tensor, burn's otherwise, and never ours on a CPU tensor.
+#[test]
+fn the_linear_layers_take_the_kernels_the_setting_names() {
+    use brdf_neural::gpu_linear::GpuLinear;
+    let ours = GpuLinear::from_env().unwrap() == GpuLinear::Ours;
+    let on_gpu = Tensor::<2>::zeros([4, 3], &gpu().device().unwrap());
+    let on_cpu = Tensor::<2>::zeros([4, 3], &brdf_neural::device::cpu());
+    assert_eq!(brdf_neural::linear_op::uses_gpu_kernels(&on_gpu), ours);
+    assert!(!brdf_neural::linear_op::uses_gpu_kernels(&on_cpu));
 }
 
 #[test]

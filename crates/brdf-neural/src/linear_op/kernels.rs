@@ -1,7 +1,11 @@
 //! The extension trait [`LinearKernels`], its flex implementation (the `cpu-kernels` crate
-//! through [`crate::flex_linear`]) and its autodiff implementation (one graph node per layer).
+//! through [`crate::flex_linear`]), its CubeCL implementation (the `gpu-kernels` crate through
+//! `crate::cube_linear`, which burn's fusion runs as one custom operation each) and its
+//! autodiff implementation (one graph node per layer).
 
 use crate::precision::MatmulPrecision;
+#[cfg(feature = "flex")]
+use burn::backend::Flex;
 use burn::backend::autodiff::NodeId;
 use burn::backend::autodiff::checkpoint::base::Checkpointer;
 use burn::backend::autodiff::checkpoint::strategy::CheckpointStrategy;
@@ -9,10 +13,11 @@ use burn::backend::autodiff::grads::Gradients;
 use burn::backend::autodiff::ops::{Backward, Ops, OpsKind};
 use burn::backend::ops::ActivationOps;
 use burn::backend::tensor::FloatTensor;
-use burn::backend::{Autodiff, Backend, Dispatch, Flex, backend_extension};
-use burn::tensor::Tensor;
+use burn::backend::{Autodiff, Backend, Dispatch, backend_extension};
+use burn::tensor::{Shape, Tensor};
 
 /// The kernels' spelling of a precision.
+#[cfg(feature = "flex")]
 fn kernel_precision(p: MatmulPrecision) -> cpu_kernels::Precision {
     match p {
         MatmulPrecision::F32 => cpu_kernels::Precision::F32,
@@ -20,12 +25,39 @@ fn kernel_precision(p: MatmulPrecision) -> cpu_kernels::Precision {
     }
 }
 
+/// The shape of `a b` for 2-d `a` and `b` (what fusion records before the product runs).
+fn product_shape(a: &Shape, b: &Shape) -> Shape {
+    Shape::new([a[0], b[1]])
+}
+
+/// The shape of `a bᵀ`.
+fn product_shape_bt(a: &Shape, b: &Shape) -> Shape {
+    Shape::new([a[0], b[0]])
+}
+
+/// The shape of `aᵀ b`.
+fn product_shape_at(a: &Shape, b: &Shape) -> Shape {
+    Shape::new([a[1], b[1]])
+}
+
+/// The shape of a column sum of `a`.
+fn column_shape(a: &Shape) -> Shape {
+    Shape::new([a[1]])
+}
+
 /// A linear layer's forward and gradient products, for backends with kernels of their own.
 /// (burn 0.22.1's extension macro does not route an `Option` of a tensor, hence a separate
-/// operation for layers without bias.)
-#[backend_extension(Flex, Autodiff)]
+/// operation for layers without bias.) The `fusion` attributes give each output's type and
+/// shape, which burn's fusion records before it runs the operation.
+#[backend_extension(
+    Flex: cfg(feature = "flex"),
+    Cube: cfg(any(feature = "wgpu", feature = "cuda")),
+    Fusion: cfg(any(feature = "wgpu", feature = "cuda")),
+    Autodiff
+)]
 pub trait LinearKernels: Backend {
     /// `x W + b` for x `[rows, d_in]`, W `[d_in, d_out]`, b `[d_out]`.
+    #[fusion(dtype = x, shape = product_shape(x, weight))]
     fn kernel_linear(
         x: FloatTensor<Self>,
         weight: FloatTensor<Self>,
@@ -34,6 +66,7 @@ pub trait LinearKernels: Backend {
     ) -> FloatTensor<Self>;
 
     /// `x W`, a layer without bias.
+    #[fusion(dtype = x, shape = product_shape(x, weight))]
     fn kernel_linear_no_bias(
         x: FloatTensor<Self>,
         weight: FloatTensor<Self>,
@@ -41,6 +74,7 @@ pub trait LinearKernels: Backend {
     ) -> FloatTensor<Self>;
 
     /// The input gradient `dY Wᵀ`.
+    #[fusion(dtype = output_grad, shape = product_shape_bt(output_grad, weight))]
     fn kernel_linear_x_backward(
         weight: FloatTensor<Self>,
         output_grad: FloatTensor<Self>,
@@ -48,6 +82,7 @@ pub trait LinearKernels: Backend {
     ) -> FloatTensor<Self>;
 
     /// The weight gradient `Xᵀ dY`.
+    #[fusion(dtype = output_grad, shape = product_shape_at(x, output_grad))]
     fn kernel_linear_weight_backward(
         x: FloatTensor<Self>,
         output_grad: FloatTensor<Self>,
@@ -55,16 +90,20 @@ pub trait LinearKernels: Backend {
     ) -> FloatTensor<Self>;
 
     /// The bias gradient: `dY` `[rows, d_out]` summed over the rows.
+    #[fusion(dtype = output_grad, shape = column_shape(output_grad))]
     fn kernel_linear_bias_backward(output_grad: FloatTensor<Self>) -> FloatTensor<Self>;
 
     /// `max(x, 0)`.
+    #[fusion(dtype = x, shape = x)]
     fn kernel_relu(x: FloatTensor<Self>) -> FloatTensor<Self>;
 
     /// The gradient of [`LinearKernels::kernel_relu`] at `x` for the upstream gradient `grad`:
     /// `grad` where `x > 0` (or NaN), 0 elsewhere.
+    #[fusion(dtype = grad, shape = grad)]
     fn kernel_relu_backward(x: FloatTensor<Self>, grad: FloatTensor<Self>) -> FloatTensor<Self>;
 }
 
+#[cfg(feature = "flex")]
 impl LinearKernels for Flex {
     fn kernel_linear(
         x: FloatTensor<Self>,
@@ -294,12 +333,13 @@ impl<B: LinearKernels, C: CheckpointStrategy> LinearKernels for Autodiff<B, C> {
 }
 
 /// [`super::relu`] on a flex device, through the extension.
+#[cfg(feature = "flex")]
 pub(super) fn relu(x: Tensor<2>) -> Tensor<2> {
     Tensor::from_dispatch(<Dispatch as LinearKernels>::kernel_relu(x.into_dispatch()))
 }
 
-/// [`super::linear`] on a flex device, through the extension, which burn routes to
-/// `Autodiff<Flex>` or `Flex`.
+/// [`super::linear`] through the extension, which burn routes to the backend of the tensors
+/// (`Autodiff<Flex>`, `Flex`, `Autodiff<Cube>` or `Cube`).
 pub(super) fn linear(
     x: Tensor<2>,
     weight: Tensor<2>,

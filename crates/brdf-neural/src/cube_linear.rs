@@ -1,0 +1,140 @@
+//! The glue between burn's CubeCL tensors and the `gpu-kernels` crate: [`LinearKernels`] for
+//! `CubeBackend` (burn-cubecl's unfused backend; the extension macro lowers each operation into
+//! one custom operation of burn's fusion, which calls these when it executes).
+//!
+//! The kernels take row-major f32 matrices: an operand with other strides is first made
+//! contiguous (burn's own kernel), and a tensor of another float type, or a shape past the
+//! kernels' grid limits, takes burn's own operations instead, so every input has an answer.
+//! Each layer's products run in f32 ([`MatmulPrecision::Bf16`] is refused off the CPU by
+//! [`MatmulPrecision::scope`]).
+
+use crate::linear_op::LinearKernels;
+use crate::precision::MatmulPrecision;
+use burn::backend::ops::{ActivationOps, FloatTensorOps};
+use burn::backend::tensor::FloatTensor;
+use burn::tensor::{DType, Shape};
+use burn_cubecl::CubeBackend;
+use burn_cubecl::tensor::CubeTensor;
+use gpu_kernels::linear::{self as kernels, Matrix};
+
+type B = CubeBackend;
+
+/// The tensor as a row-major matrix (made contiguous first where it is not), or `None` for a
+/// type other than f32 or a shape that is not 2-d.
+fn matrix(t: CubeTensor) -> Option<(CubeTensor, Matrix)> {
+    if t.dtype != DType::F32 || t.meta.shape().num_dims() != 2 {
+        return None;
+    }
+    let t = if t.is_contiguous() { t } else { burn_cubecl::kernel::into_contiguous(t) };
+    let [rows, cols] = t.meta.shape().dims::<2>();
+    let m = Matrix {
+        handle: t.handle.clone(),
+        rows: u32::try_from(rows).ok()?,
+        cols: u32::try_from(cols).ok()?,
+    };
+    Some((t, m))
+}
+
+/// A kernel's output as a tensor on `like`'s device.
+fn tensor(like: &CubeTensor, m: Matrix, shape: Shape) -> CubeTensor {
+    CubeTensor::new_contiguous(
+        like.client.clone(),
+        like.device.clone(),
+        shape,
+        m.handle,
+        DType::F32,
+    )
+}
+
+/// `b` `[n]` seen as `[1, n]`, for burn's broadcast add.
+fn row(b: FloatTensor<B>) -> FloatTensor<B> {
+    let n = b.meta.shape()[0];
+    B::float_reshape(b, Shape::new([1, n]))
+}
+
+impl LinearKernels for CubeBackend {
+    fn kernel_linear(
+        x: FloatTensor<Self>,
+        weight: FloatTensor<Self>,
+        bias: FloatTensor<Self>,
+        _precision: MatmulPrecision,
+    ) -> FloatTensor<Self> {
+        if let (Some((xt, xm)), Some((_, wm)), Some((_, bm))) =
+            (matrix(x.clone()), matrix(weight.clone()), matrix(row(bias.clone())))
+            && let Ok(y) = kernels::forward(&xt.client, &xm, &wm, Some(&bm.handle), false)
+        {
+            let shape = Shape::new([y.rows as usize, y.cols as usize]);
+            return tensor(&xt, y, shape);
+        }
+        B::float_add(B::float_matmul(x, weight), row(bias))
+    }
+
+    fn kernel_linear_no_bias(
+        x: FloatTensor<Self>,
+        weight: FloatTensor<Self>,
+        _precision: MatmulPrecision,
+    ) -> FloatTensor<Self> {
+        if let (Some((xt, xm)), Some((_, wm))) = (matrix(x.clone()), matrix(weight.clone()))
+            && let Ok(y) = kernels::forward(&xt.client, &xm, &wm, None, false)
+        {
+            let shape = Shape::new([y.rows as usize, y.cols as usize]);
+            return tensor(&xt, y, shape);
+        }
+        B::float_matmul(x, weight)
+    }
+
+    fn kernel_linear_x_backward(
+        weight: FloatTensor<Self>,
+        output_grad: FloatTensor<Self>,
+        _precision: MatmulPrecision,
+    ) -> FloatTensor<Self> {
+        if let (Some((_, wm)), Some((gt, gm))) =
+            (matrix(weight.clone()), matrix(output_grad.clone()))
+            && let Ok(dx) = kernels::x_backward(&gt.client, &wm, &gm)
+        {
+            let shape = Shape::new([dx.rows as usize, dx.cols as usize]);
+            return tensor(&gt, dx, shape);
+        }
+        B::float_matmul(output_grad, B::float_transpose(weight))
+    }
+
+    fn kernel_linear_weight_backward(
+        x: FloatTensor<Self>,
+        output_grad: FloatTensor<Self>,
+        _precision: MatmulPrecision,
+    ) -> FloatTensor<Self> {
+        if let (Some((xt, xm)), Some((_, gm))) = (matrix(x.clone()), matrix(output_grad.clone()))
+            && let Ok(dw) = kernels::weight_backward(&xt.client, &xm, &gm)
+        {
+            let shape = Shape::new([dw.rows as usize, dw.cols as usize]);
+            return tensor(&xt, dw, shape);
+        }
+        B::float_matmul(B::float_transpose(x), output_grad)
+    }
+
+    fn kernel_linear_bias_backward(output_grad: FloatTensor<Self>) -> FloatTensor<Self> {
+        if let Some((gt, gm)) = matrix(output_grad.clone())
+            && let Ok(db) = kernels::bias_backward(&gt.client, &gm)
+        {
+            let shape = Shape::new([db.cols as usize]);
+            return tensor(&gt, db, shape);
+        }
+        let n = output_grad.meta.shape()[1];
+        B::float_reshape(B::float_sum_dim(output_grad, 0), Shape::new([n]))
+    }
+
+    fn kernel_relu(x: FloatTensor<Self>) -> FloatTensor<Self> {
+        <B as ActivationOps<B>>::relu(x)
+    }
+
+    fn kernel_relu_backward(x: FloatTensor<Self>, grad: FloatTensor<Self>) -> FloatTensor<Self> {
+        if let (Some((_, xm)), Some((gt, gm))) = (matrix(x.clone()), matrix(grad.clone()))
+            && let Ok(out) = kernels::relu_backward(&gt.client, &xm, &gm)
+        {
+            let shape = Shape::new([out.rows as usize, out.cols as usize]);
+            return tensor(&gt, out, shape);
+        }
+        // burn's mask is taken from the output, max(x, 0), which is positive where x is.
+        <B as ActivationOps<B>>::relu_backward(<B as ActivationOps<B>>::relu(x), grad)
+    }
+}

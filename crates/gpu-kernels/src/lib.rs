@@ -1,0 +1,19 @@
+//! The GPU kernels of the neural models' linear layers, written in CubeCL (one kernel source for
+//! CUDA, Vulkan/WGSL and Metal), on plain device buffers: no tensor library, so that a burn
+//! backend extension can hand them its buffers as `cpu-kernels` gets flex's on the CPU.
+//!
+//! | module | what |
+//! | --- | --- |
+//! | [`gemm`] | the tiled f32 product with strided operands, the bias and ReLU fused, split-K |
+//! | [`reduce`] | fixed-order sums: split-K's partials, column sums (the bias gradient) |
+//! | [`elementwise`] | the ReLU backward |
+//! | [`linear`] | a layer's five operations on row-major [`linear::Matrix`]es, shapes checked |
+//!
+//! Every sum runs in an order fixed by the shapes (split counts depend on the batch length
+//! alone), so a result is the same bits run to run. The tests (`--features wgpu`) compare each
+//! operation with an f64 reference on any Vulkan device, Mesa's lavapipe included.
+
+pub mod elementwise;
+pub mod gemm;
+pub mod linear;
+pub mod reduce;
