@@ -14,7 +14,9 @@ use burn::backend::autodiff::ops::{Backward, Ops, OpsKind};
 use burn::backend::ops::ActivationOps;
 use burn::backend::tensor::FloatTensor;
 use burn::backend::{Autodiff, Backend, Dispatch, backend_extension};
-use burn::tensor::{Shape, Tensor};
+#[cfg(any(feature = "wgpu", feature = "cuda"))]
+use burn::tensor::Shape;
+use burn::tensor::Tensor;
 
 /// The kernels' spelling of a precision.
 #[cfg(feature = "flex")]
@@ -26,21 +28,25 @@ fn kernel_precision(p: MatmulPrecision) -> cpu_kernels::Precision {
 }
 
 /// The shape of `a b` for 2-d `a` and `b` (what fusion records before the product runs).
+#[cfg(any(feature = "wgpu", feature = "cuda"))]
 fn product_shape(a: &Shape, b: &Shape) -> Shape {
     Shape::new([a[0], b[1]])
 }
 
 /// The shape of `a bᵀ`.
+#[cfg(any(feature = "wgpu", feature = "cuda"))]
 fn product_shape_bt(a: &Shape, b: &Shape) -> Shape {
     Shape::new([a[0], b[0]])
 }
 
 /// The shape of `aᵀ b`.
+#[cfg(any(feature = "wgpu", feature = "cuda"))]
 fn product_shape_at(a: &Shape, b: &Shape) -> Shape {
     Shape::new([a[1], b[1]])
 }
 
 /// The shape of a column sum of `a`.
+#[cfg(any(feature = "wgpu", feature = "cuda"))]
 fn column_shape(a: &Shape) -> Shape {
     Shape::new([a[1]])
 }
