@@ -19,7 +19,10 @@
 #   bash benches/device_gpu.sh kinds     # the wgpu step of all 9 kinds against PyTorch's step of
 #                                        # each kind on CUDA: eager f32, TF32, a CUDA graph
 #   bash benches/device_gpu.sh linear    # the linear layers on gpu-kernels against burn's:
-#                                        # correctness, all 9 kinds' steps, the training loop
+#                                        # correctness, all 9 kinds' steps beside PyTorch's,
+#                                        # split lengths, the training loop
+#   bash benches/device_gpu.sh tiles     # after `linear`: gpu-kernels' split rule and both
+#                                        # tiles, every kind beside PyTorch, the loop
 #
 # With autotune on (the wgpu feature), the first use of every matrix-product shape in a process
 # is benchmarked, and the first process on a fresh machine also compiles every kernel and runs
@@ -269,10 +272,15 @@ if [ "$STAGE" = cpu ]; then
     # on one. No GPU is used. The package's Python sources come from the checkout.
     export PYTHONPATH=$PWD/crates/py-neural-brdfs/python${PYTHONPATH:+:$PYTHONPATH}
     lscpu | grep -E "Model name|^CPU\(s\)|Thread|Flags" | cut -c1-300
-    step "weight gradients: all threads, then one"
-    run 60 wgrad_all.log env CPU_KERNELS_BENCH_BATCH=32768 $B/weight_gradient --bench '^$'
-    run 60 wgrad_one.log env CPU_KERNELS_BENCH_BATCH=32768 RAYON_NUM_THREADS=1 \
-        $B/weight_gradient --bench '^$'
+    # A short call (the second of a lease): CPU_WGRAD=0 skips the weight gradients alone,
+    # PYTORCH_ROUNDS=1 times PyTorch once a kind instead of three times.
+    export BRDF_BENCH_PYTORCH_ROUNDS=${PYTORCH_ROUNDS:-3}
+    if [ "${CPU_WGRAD:-1}" != 0 ]; then
+        step "weight gradients: all threads, then one"
+        run 60 wgrad_all.log env CPU_KERNELS_BENCH_BATCH=32768 $B/weight_gradient --bench '^$'
+        run 60 wgrad_one.log env CPU_KERNELS_BENCH_BATCH=32768 RAYON_NUM_THREADS=1 \
+            $B/weight_gradient --bench '^$'
+    fi
     step "the f32 step on all cores, all 9 kinds, against PyTorch on as many threads"
     run 300 step_cpu_all.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_ALL_MODELS=1 \
         BRDF_BENCH_BACKENDS=flex BRDF_BENCH_PYTORCH=python3 $B/train_step --bench
@@ -284,35 +292,78 @@ fi
 if [ "$STAGE" = linear ]; then
     # The linear layers on this workspace's GPU kernels (`gpu-kernels`, NEURAL_BRDF_GPU_LINEAR=
     # ours: the bias fused into a tiled product, split-K inside the weight gradient) against
-    # burn's (CubeCL's autotuned product, the trainer's batch split): first the wgpu tests
-    # against the CPU on our kernels; then every kind's step at batch 2^15, burn's kernels and
-    # ours alternated twice, with PyTorch eager f32 (TF32 off) in the same process as the
-    # reference; then the default run's Single MLP for 1,400 steps on each, `nvidia-smi dmon`
-    # sampling the SM use. One call: DEVICE_DEADLINE=560 bash benches/device_gpu.sh linear
+    # burn's (CubeCL's autotuned product, the trainer's batch split), in one call of a 15-minute
+    # lease: first the wgpu tests against the CPU on our kernels; then every kind's step at
+    # batch 2^15 on ours, each back to back with PyTorch eager f32 (TF32 off, one round), and
+    # the same steps on burn's kernels; the Single MLP's step with other split lengths
+    # (NEURAL_BRDF_GPU_SPLIT_LEN); then the default run's Single MLP for 1,400 steps on each,
+    # `nvidia-smi dmon` sampling the SM use. All processes share one persistent GPU cache, so
+    # autotune's choices are paid once. One call: DEVICE_DEADLINE=470 bash benches/device_gpu.sh linear
     export PYTHONPATH=$PWD/crates/py-neural-brdfs/python${PYTHONPATH:+:$PYTHONPATH}
+    export NEURAL_BRDF_GPU_CACHE=/tmp/gpu-cache
+    python3 -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name(0))"
     step "wgpu against the CPU on this GPU, the linear layers on gpu-kernels"
-    run 90 gpu_backend_ours.log env NEURAL_BRDF_GPU_LINEAR=ours CUBECL_AUTOTUNE_LEVEL=minimal \
+    run 60 gpu_backend_ours.log env NEURAL_BRDF_GPU_LINEAR=ours CUBECL_AUTOTUNE_LEVEL=minimal \
         $B/gpu_backend --test-threads=1
-    for round in 1 2; do
-        for kernels in burn ours; do
-            step "the wgpu step, all 9 kinds, linear layers on $kernels (round $round)"
-            py=()
-            [ "$round" = 1 ] && [ "$kernels" = burn ] && py=(BRDF_BENCH_PYTORCH=python3)
-            run 110 "step_${kernels}_r$round.log" env NEURAL_BRDF_GPU_LINEAR=$kernels \
-                BRDF_BENCH_QUICK=1 BRDF_BENCH_ALL_MODELS=1 BRDF_BENCH_BACKENDS=wgpu \
-                BRDF_BENCH_RATES=1 "${py[@]}" $B/train_step --bench
-        done
+    step "the wgpu step, all 9 kinds, linear layers on ours, against PyTorch eager f32"
+    run 150 step_ours.log env NEURAL_BRDF_GPU_LINEAR=ours BRDF_BENCH_QUICK=1 \
+        BRDF_BENCH_ALL_MODELS=1 BRDF_BENCH_BACKENDS=wgpu BRDF_BENCH_RATES=1 \
+        BRDF_BENCH_PYTORCH=python3 BRDF_BENCH_PYTORCH_ROUNDS=1 $B/train_step --bench
+    step "the wgpu step, all 9 kinds, linear layers on burn's kernels"
+    run 120 step_burn.log env NEURAL_BRDF_GPU_LINEAR=burn BRDF_BENCH_QUICK=1 \
+        BRDF_BENCH_ALL_MODELS=1 BRDF_BENCH_BACKENDS=wgpu BRDF_BENCH_RATES=1 $B/train_step --bench
+    for len in 512 8192; do
+        step "the Single MLP step on ours, split length $len"
+        run 30 "step_ours_split$len.log" env NEURAL_BRDF_GPU_LINEAR=ours \
+            NEURAL_BRDF_GPU_SPLIT_LEN=$len BRDF_BENCH_QUICK=1 BRDF_BENCH_MODELS=single_mlp \
+            BRDF_BENCH_BACKENDS=wgpu BRDF_BENCH_RATES=1 $B/train_step --bench
     done
     export PROFILE_WARMUP_STEPS=50 PROFILE_EVAL=none
     run 40 default_scenes.log $B/profile_steps --prepare default /tmp/default
     nvidia-smi dmon -s u -d 1 -o T >"$LOGS/gpu_use.log" 2>&1 &
     DMON=$!
-    for kernels in burn ours; do
+    for kernels in ours burn; do
         echo "== $(date +%T) kernels $kernels" >>"$LOGS/gpu_use.log"
-        run 60 "loop_$kernels.log" env NEURAL_BRDF_GPU_LINEAR=$kernels $B/profile_steps \
+        run 45 "loop_$kernels.log" env NEURAL_BRDF_GPU_LINEAR=$kernels $B/profile_steps \
             /tmp/default spot__blue-acrylic 1400 wgpu SingleMlp
     done
     kill $DMON
+fi
+if [ "$STAGE" = tiles ]; then
+    # After `linear` (same lease): gpu-kernels with the weight gradient's splits chosen to fill
+    # the GPU (256 cubes) and the bias gradient in blocks of 128 rows, on both tiles. The wgpu
+    # tests on the real GPU (64- and 128-wide tiles), every kind's step on ours back to back
+    # with PyTorch eager f32 (one round), the Single MLP's step on 128-wide tiles and with splits
+    # of 256 rows, the default run's Single MLP and FMBRDF for 1,400 steps with `nvidia-smi
+    # dmon`, then every kind's step on 128-wide tiles. One call:
+    # DEVICE_DEADLINE=320 bash benches/device_gpu.sh tiles
+    export PYTHONPATH=$PWD/crates/py-neural-brdfs/python${PYTHONPATH:+:$PYTHONPATH}
+    export NEURAL_BRDF_GPU_CACHE=/tmp/gpu-cache NEURAL_BRDF_GPU_LINEAR=ours
+    for tile in 64 128; do
+        step "wgpu against the CPU on this GPU, gpu-kernels, $tile-wide tiles"
+        run 40 "gpu_backend_t$tile.log" env NEURAL_BRDF_GPU_TILE=$tile \
+            CUBECL_AUTOTUNE_LEVEL=minimal $B/gpu_backend --test-threads=1
+    done
+    step "the wgpu step, all 9 kinds, on ours, against PyTorch eager f32"
+    run 130 step_ours.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_ALL_MODELS=1 \
+        BRDF_BENCH_BACKENDS=wgpu BRDF_BENCH_RATES=1 BRDF_BENCH_PYTORCH=python3 \
+        BRDF_BENCH_PYTORCH_ROUNDS=1 $B/train_step --bench
+    for variant in NEURAL_BRDF_GPU_TILE=128 NEURAL_BRDF_GPU_SPLIT_LEN=256; do
+        step "the Single MLP step on ours, $variant"
+        run 25 "step_ours_${variant##*_}.log" env "$variant" BRDF_BENCH_QUICK=1 \
+            BRDF_BENCH_MODELS=single_mlp BRDF_BENCH_BACKENDS=wgpu BRDF_BENCH_RATES=1 \
+            $B/train_step --bench
+    done
+    export PROFILE_WARMUP_STEPS=50 PROFILE_EVAL=none
+    run 30 default_scenes.log $B/profile_steps --prepare default /tmp/default
+    nvidia-smi dmon -s u -d 1 -o T >"$LOGS/gpu_use.log" 2>&1 &
+    DMON=$!
+    run 50 loop_ours.log $B/profile_steps /tmp/default spot__blue-acrylic 1400 wgpu \
+        SingleMlp,Fmbrdf
+    kill $DMON
+    step "the wgpu step, all 9 kinds, on ours with 128-wide tiles"
+    run 80 step_ours_t128.log env NEURAL_BRDF_GPU_TILE=128 BRDF_BENCH_QUICK=1 \
+        BRDF_BENCH_ALL_MODELS=1 BRDF_BENCH_BACKENDS=wgpu BRDF_BENCH_RATES=1 $B/train_step --bench
 fi
 step "done"
 tar -czf "$OUT/$STAGE.tar.gz" -C "$LOGS" .

@@ -14,7 +14,8 @@
 //!   the same step in PyTorch for every model timed (`--kind`, the model rebuilt from
 //!   `neural_brdfs.reference_torch` in the same default configuration) on the same number of
 //!   threads (on CUDA for the GPU backends), back to back with ours: three rounds of 10 steps
-//!   each side after warm-up, and prints the ratios;
+//!   each side after warm-up (`BRDF_BENCH_PYTORCH_ROUNDS` sets another count), and prints the
+//!   ratios;
 //! - `BRDF_BENCH_MODELS=single_mlp,disney` times only these models (names as in the summary:
 //!   each kind's `config_name`);
 //!   `BRDF_BENCH_RATES=0` skips the gemm and product rates and prints nothing (for `perf`);
@@ -352,7 +353,11 @@ fn bench(cr: &mut Criterion) {
                 // Each side warms up first (PyTorch's script runs 3 untimed steps); bf16 is
                 // compared with PyTorch's bf16 autocast.
                 let bf16 = precision == MatmulPrecision::Bf16;
-                for _ in 0..3 {
+                let rounds = std::env::var("BRDF_BENCH_PYTORCH_ROUNDS")
+                    .ok()
+                    .map(|r| r.parse::<usize>().expect("BRDF_BENCH_PYTORCH_ROUNDS: a number"))
+                    .unwrap_or(3);
+                for _ in 0..rounds {
                     median_step(&mut step, 3);
                     let ours = median_step(&mut step, 10);
                     // A bf16 round also times PyTorch's f32 step right after its autocast one:
@@ -509,20 +514,7 @@ fn layer_products(backend: Backend, n: usize) {
     let x: Tensor<2> = Tensor::random([n, 128], Distribution::Uniform(-1.0, 1.0), &device);
     let dy: Tensor<2> = Tensor::random([n, 128], Distribution::Uniform(-1.0, 1.0), &device);
     let w: Tensor<2> = Tensor::random([128, 128], Distribution::Uniform(-1.0, 1.0), &device);
-    let time = |f: &dyn Fn() -> Tensor<2>| {
-        let mut times: Vec<f64> = (0..14)
-            .map(|_| {
-                let t = Instant::now();
-                let out = f();
-                device.sync().expect("sync");
-                std::hint::black_box(out);
-                t.elapsed().as_secs_f64()
-            })
-            .skip(3)
-            .collect();
-        times.sort_by(f64::total_cmp);
-        times[times.len() / 2]
-    };
+    let time = |f: &dyn Fn() -> Tensor<2>| time_on(&device, f);
     let flops = 2.0 * (n * 128 * 128) as f64;
     let mut rows = vec![
         ("forward X W".to_string(), time(&|| x.clone().matmul(w.clone()))),
@@ -534,12 +526,56 @@ fn layer_products(backend: Backend, n: usize) {
         let f = || split(&x).swap_dims(1, 2).matmul(split(&dy)).sum_dim(0).reshape([128, 128]);
         rows.push((format!("weight gradient, {parts} parts"), time(&f)));
     }
+    // One whole layer as the models run it (`linear_op`: burn's kernels or gpu-kernels, as
+    // NEURAL_BRDF_GPU_LINEAR says), forward alone, then forward and backward (dX, dW, db: the
+    // three products' FLOPs, so its GFLOP/s counts 3 products).
+    let train = backend.training_device().expect("backend built");
+    let random = |shape: [usize; 2]| {
+        Tensor::<2>::random(shape, Distribution::Uniform(-1.0, 1.0), &train).require_grad()
+    };
+    let (xt, wt) = (random([n, 128]), random([128, 128]));
+    let bt = Tensor::<1>::random([128], Distribution::Uniform(-1.0, 1.0), &train).require_grad();
+    let layer = || {
+        let f32 = MatmulPrecision::F32;
+        brdf_neural::linear_op::linear(xt.clone(), wt.clone(), Some(bt.clone()), f32)
+    };
+    let which = if brdf_neural::linear_op::uses_gpu_kernels(&xt) { "gpu-kernels" } else { "burn" };
+    rows.push((format!("layer x W + b ({which})"), time_on(&train, &layer)));
+    let backward = || {
+        let grads = layer().sum().backward();
+        let (dx, dw) = (xt.grad(&grads).expect("dX"), wt.grad(&grads).expect("dW"));
+        let db = bt.grad(&grads).expect("db");
+        // One output that needs all three (so none is skipped), broadcast over dW's rows.
+        dw + db.unsqueeze::<2>() + dx.slice([0..1, 0..128])
+    };
+    let layer_fb = time_on(&train, &backward);
     println!("\n{backend:?}: one layer's products at batch {n}, 128 x 128 (medians of 11)");
     println!("| product | ms | GFLOP/s |");
     println!("| --- | ---: | ---: |");
     for (name, secs) in rows {
         println!("| {name} | {:.3} | {:.0} |", secs * 1e3, flops / secs / 1e9);
     }
+    println!(
+        "| layer forward + backward ({which}) | {:.3} | {:.0} |",
+        layer_fb * 1e3,
+        3.0 * flops / layer_fb / 1e9
+    );
+}
+
+/// The median of 11 timed calls of `f` (after 3 untimed), each waited for on `device`.
+fn time_on(device: &Device, f: &dyn Fn() -> Tensor<2>) -> f64 {
+    let mut times: Vec<f64> = (0..14)
+        .map(|_| {
+            let t = Instant::now();
+            let out = f();
+            device.sync().expect("sync");
+            std::hint::black_box(out);
+            t.elapsed().as_secs_f64()
+        })
+        .skip(3)
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[times.len() / 2]
 }
 
 /// GFLOP/s (f32, bf16) of flex's products through burn tensors, best of 11: the forward

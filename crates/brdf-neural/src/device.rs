@@ -58,6 +58,16 @@ impl std::fmt::Display for Backend {
     }
 }
 
+/// Whether `x` lives on a GPU (a CubeCL device: `wgpu` or `cuda`).
+pub fn on_gpu<const D: usize>(x: &burn::tensor::Tensor<D>) -> bool {
+    #[cfg(any(feature = "wgpu", feature = "cuda"))]
+    if matches!(x.device().inner().as_dispatch(), burn::backend::DispatchDevice::Cube(_)) {
+        return true;
+    }
+    let _ = x;
+    false
+}
+
 impl Backend {
     /// Every backend, built or not.
     pub const ALL: [Backend; 4] = [Backend::Flex, Backend::NdArray, Backend::Wgpu, Backend::Cuda];
@@ -131,7 +141,7 @@ impl Backend {
             Backend::Wgpu => {
                 #[cfg(feature = "wgpu")]
                 {
-                    crate::gpu_linear::GpuLinear::from_env()?;
+                    crate::gpu_linear::configure()?;
                     crate::gpu_cache::configure();
                     return Ok(Device::wgpu(Default::default()));
                 }
@@ -149,7 +159,7 @@ impl Backend {
                                 .into(),
                         ));
                     }
-                    crate::gpu_linear::GpuLinear::from_env()?;
+                    crate::gpu_linear::configure()?;
                     crate::gpu_cache::configure();
                     return Ok(Device::cuda(0usize));
                 }

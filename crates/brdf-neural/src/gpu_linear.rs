@@ -2,12 +2,23 @@
 //!
 //! | value of `NEURAL_BRDF_GPU_LINEAR` | kernels |
 //! | --- | --- |
-//! | `burn` (the default) | burn's: CubeCL's autotuned matrix product; the trainer splits the batch ([`crate::split_k`]) so that autodiff splits the weight gradients |
-//! | `ours` | this workspace's `gpu-kernels`: a tiled product with the bias fused, the weight gradient split over the batch inside its kernel and its parts added in a fixed order, through the same backend extension as the CPU kernels ([`crate::linear_op`]) |
+//! | `ours` (the default) | this workspace's `gpu-kernels`: a tiled product with the bias fused, the weight gradient split over the batch inside its kernel and its parts added in a fixed order, through the same backend extension as the CPU kernels ([`crate::linear_op`]) |
+//! | `burn` | burn's: CubeCL's autotuned matrix product; the trainer splits the batch ([`crate::split_k`]) so that autodiff splits the weight gradients |
 //!
 //! The choice is per process (the environment is read once). An unknown value is refused when a
-//! GPU device is made ([`crate::device::Backend::device`]), naming the variable. `ours` is off
-//! by default until it is measured faster on a GPU (`benches/device_gpu.sh`, stage `linear`).
+//! GPU device is made ([`crate::device::Backend::device`]), naming the variable. `ours` is the
+//! default since it was measured on an H200 (2026-11-28, `benches/README.md`): as fast as burn's
+//! kernels once burn's autotune has settled (Single MLP step 4.6 against 4.5 ms at 2^15, Disney
+//! 8.6 to 9.0 against 8.7), three times faster in a first process, before the autotune cache
+//! holds burn's shapes (4.6 against 14.2 ms), and its sums run in a fixed order.
+//!
+//! Two tuning settings of `ours`, for benchmarks, read (and a bad value refused) when a GPU
+//! device is made like the choice of kernels:
+//!
+//! | variable | values | default |
+//! | --- | --- | --- |
+//! | `NEURAL_BRDF_GPU_SPLIT_LEN` | batch rows each split of a weight gradient sums: a power of two from 64 to 65,536 | `gpu_kernels::linear::splits`' rule (enough splits for 256 cubes) |
+//! | `NEURAL_BRDF_GPU_TILE` | the products' tile: `64` or `128` | `64` |
 
 use std::sync::OnceLock;
 
@@ -18,9 +29,9 @@ pub const VAR: &str = "NEURAL_BRDF_GPU_LINEAR";
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum GpuLinear {
     /// burn's own `linear` (CubeCL's matrix product).
-    #[default]
     Burn,
     /// The `gpu-kernels` crate.
+    #[default]
     Ours,
 }
 
@@ -28,29 +39,78 @@ impl GpuLinear {
     /// Parses `burn` or `ours`.
     pub fn parse(value: &str) -> crate::Result<Self> {
         match value.trim().to_ascii_lowercase().as_str() {
-            "burn" | "" => Ok(GpuLinear::Burn),
-            "ours" => Ok(GpuLinear::Ours),
+            "burn" => Ok(GpuLinear::Burn),
+            "ours" | "" => Ok(GpuLinear::Ours),
             other => Err(crate::Error::Setting(format!(
-                "{VAR}={other:?}: expected `burn` (burn's kernels, the default) or `ours` \
-                 (the gpu-kernels crate)"
+                "{VAR}={other:?}: expected `ours` (the gpu-kernels crate, the default) or \
+                 `burn` (burn's kernels)"
             ))),
         }
     }
 
-    /// The value of [`VAR`] (`burn` where it is not set).
+    /// The value of [`VAR`] (`ours` where it is not set).
     pub fn from_env() -> crate::Result<Self> {
         match std::env::var(VAR) {
             Ok(v) => Self::parse(&v),
-            Err(_) => Ok(GpuLinear::Burn),
+            Err(_) => Ok(GpuLinear::Ours),
         }
     }
 
     /// The process's choice: [`GpuLinear::from_env`] on first use (an unknown value, which
-    /// making a GPU device refuses, counts as `burn` here).
+    /// making a GPU device refuses, counts as the default here).
     pub fn current() -> Self {
         static CHOICE: OnceLock<GpuLinear> = OnceLock::new();
         *CHOICE.get_or_init(|| Self::from_env().unwrap_or_default())
     }
+}
+
+/// The environment variable that sets the split length of `ours`' weight gradients.
+pub const SPLIT_VAR: &str = "NEURAL_BRDF_GPU_SPLIT_LEN";
+
+/// Parses a split length (see the module documentation).
+pub fn parse_split_len(value: &str) -> crate::Result<u32> {
+    let len = value.trim().parse::<u32>().ok();
+    match len {
+        Some(len) if len.is_power_of_two() && (64..=65_536).contains(&len) => Ok(len),
+        _ => Err(crate::Error::Setting(format!(
+            "{SPLIT_VAR}={value:?}: expected a power of two from 64 to 65536 (batch rows per \
+             split of a weight gradient; by default the split count fills the GPU)"
+        ))),
+    }
+}
+
+/// The environment variable that sets the tile of `ours`' products.
+pub const TILE_VAR: &str = "NEURAL_BRDF_GPU_TILE";
+
+/// Parses a tile width: 64 or 128.
+pub fn parse_tile(value: &str) -> crate::Result<u32> {
+    match value.trim() {
+        "64" => Ok(64),
+        "128" => Ok(128),
+        _ => Err(crate::Error::Setting(format!(
+            "{TILE_VAR}={value:?}: expected 64 or 128 (the width of the products' tiles)"
+        ))),
+    }
+}
+
+/// Reads [`VAR`], [`SPLIT_VAR`] and [`TILE_VAR`] when a GPU device is made: an unknown value
+/// is an error naming its variable; the tuning settings are handed to the kernels.
+#[cfg(any(feature = "wgpu", feature = "cuda"))]
+pub(crate) fn configure() -> crate::Result<()> {
+    GpuLinear::from_env()?;
+    if let Ok(value) = std::env::var(SPLIT_VAR) {
+        let len = parse_split_len(&value)?;
+        gpu_kernels::linear::set_split_len(Some(len))
+            .map_err(|e| crate::Error::Setting(format!("{SPLIT_VAR}: {e}")))?;
+    }
+    if let Ok(value) = std::env::var(TILE_VAR) {
+        let tiling = match parse_tile(&value)? {
+            128 => gpu_kernels::gemm::Tiling::T128,
+            _ => gpu_kernels::gemm::Tiling::T64,
+        };
+        gpu_kernels::linear::set_tiling(tiling);
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -61,8 +121,29 @@ mod tests {
     fn values_parse_and_unknown_ones_name_the_variable() {
         assert_eq!(GpuLinear::parse("burn").unwrap(), GpuLinear::Burn);
         assert_eq!(GpuLinear::parse(" Ours ").unwrap(), GpuLinear::Ours);
-        assert_eq!(GpuLinear::parse("").unwrap(), GpuLinear::Burn);
+        assert_eq!(GpuLinear::parse("").unwrap(), GpuLinear::Ours);
+        assert_eq!(GpuLinear::default(), GpuLinear::Ours);
         let e = GpuLinear::parse("cublas").unwrap_err().to_string();
         assert!(e.contains(VAR) && e.contains("cublas") && e.contains("ours"), "{e}");
+    }
+
+    #[test]
+    fn split_lengths_parse_and_bad_ones_name_the_variable() {
+        assert_eq!(parse_split_len("512").unwrap(), 512);
+        assert_eq!(parse_split_len(" 65536 ").unwrap(), 65_536);
+        for bad in ["0", "100", "32", "131072", "-512", "lots"] {
+            let e = parse_split_len(bad).unwrap_err().to_string();
+            assert!(e.contains(SPLIT_VAR) && e.contains(bad), "{e}");
+        }
+    }
+
+    #[test]
+    fn tiles_parse_and_bad_ones_name_the_variable() {
+        assert_eq!(parse_tile("64").unwrap(), 64);
+        assert_eq!(parse_tile(" 128").unwrap(), 128);
+        for bad in ["32", "256", "wide", ""] {
+            let e = parse_tile(bad).unwrap_err().to_string();
+            assert!(e.contains(TILE_VAR) && e.contains("128"), "{e}");
+        }
     }
 }

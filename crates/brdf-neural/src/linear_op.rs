@@ -44,12 +44,8 @@ pub fn linear(
 /// Whether `x` is on a GPU (CubeCL) device whose linear layers run on this workspace's
 /// `gpu-kernels` ([`crate::gpu_linear`], `NEURAL_BRDF_GPU_LINEAR=ours`).
 pub fn uses_gpu_kernels(x: &Tensor<2>) -> bool {
-    #[cfg(any(feature = "wgpu", feature = "cuda"))]
-    if crate::gpu_linear::GpuLinear::current() == crate::gpu_linear::GpuLinear::Ours {
-        return matches!(x.device().inner().as_dispatch(), burn::backend::DispatchDevice::Cube(_));
-    }
-    let _ = x;
-    false
+    crate::gpu_linear::GpuLinear::current() == crate::gpu_linear::GpuLinear::Ours
+        && crate::device::on_gpu(x)
 }
 
 /// `max(x, 0)`, its backward pass on this workspace's kernels on the flex backend (the mask

@@ -3,11 +3,15 @@
 //! its own slice of the output (split-K: a weight gradient's long sum over the batch spread over
 //! many cubes, the partials then added in a fixed order by [`crate::reduce`]).
 //!
-//! One cube of 16 x 16 units computes a 64 x 64 tile of C; each unit keeps a 4 x 4 block of
-//! sums in registers, at rows `ty + 16 i` and columns `tx + 16 j` (so that neighbouring units
-//! read neighbouring shared-memory words and write neighbouring output words). The k axis is
-//! walked in steps of 16: each step stages a 64 x 16 slab of A and a 16 x 64 slab of B in shared
-//! memory, zero-padded past the matrix edges, so any shape is exact.
+//! One cube of 16 x 16 units computes a square tile of C, 64 or 128 wide ([`Tiling`]); each
+//! unit keeps a 4 x 4 (or 8 x 8) block of sums in registers, at rows `ty + 16 i` and columns
+//! `tx + 16 j` (so that neighbouring units read neighbouring shared-memory words and write
+//! neighbouring output words). The k axis is walked in steps of 16: each step stages a tile x
+//! 16 slab of A and a 16 x tile slab of B in shared memory, zero-padded past the matrix edges,
+//! so any shape is exact. The units load a slab along whichever of its axes is contiguous in
+//! memory (so that a warp reads consecutive words, also for the transposed operands of the
+//! gradients), and the slabs' rows in shared memory are one word longer than the tile, so that
+//! the stores of either order fall in different banks.
 //!
 //! | name | shape | meaning |
 //! | --- | --- | --- |
@@ -18,10 +22,32 @@
 
 use cubecl::prelude::*;
 
-/// Rows and columns of C per cube.
-pub const TILE: u32 = 64;
 /// Units per cube along each axis.
 pub const UNITS: u32 = 16;
+
+/// The tile of C one cube computes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Tiling {
+    /// 64 x 64, 4 x 4 sums a unit: many cubes for short or narrow products.
+    T64,
+    /// 128 x 128, 8 x 8 sums a unit: twice the arithmetic per shared-memory read.
+    T128,
+}
+
+impl Tiling {
+    /// Rows and columns of C per cube.
+    pub fn tile(self) -> u32 {
+        UNITS * self.per_unit()
+    }
+
+    /// Rows and columns of sums per unit.
+    pub fn per_unit(self) -> u32 {
+        match self {
+            Tiling::T64 => 4,
+            Tiling::T128 => 8,
+        }
+    }
+}
 /// The k step staged in shared memory.
 pub const K_STEP: u32 = 16;
 
@@ -47,7 +73,7 @@ impl Epilogue {
 }
 
 /// The product kernel; see the module documentation. Launched on a grid of
-/// `(ceil(n / 64), ceil(m / 64), splits)` cubes of 16 x 16 units.
+/// `(ceil(n / tile), ceil(m / tile), splits)` cubes of 16 x 16 units.
 #[cube(launch)]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn gemm_tiled(
@@ -64,61 +90,78 @@ pub(crate) fn gemm_tiled(
     b_cs: u32,
     k_per_split: u32,
     #[comptime] epilogue: u32,
+    #[comptime] a_rows_contiguous: bool,
+    #[comptime] b_rows_contiguous: bool,
+    #[comptime] per_unit: u32,
 ) {
     let tx = UNIT_POS_X;
     let ty = UNIT_POS_Y;
     let lin = UNIT_POS;
-    let row0 = CUBE_POS_Y * 64;
-    let col0 = CUBE_POS_X * 64;
+    let tile = comptime![16 * per_unit];
+    // Slab rows one word longer than the tile: no bank conflicts in the stores of either order.
+    let stride = comptime![16 * per_unit + 1];
+    let row0 = CUBE_POS_Y * tile;
+    let col0 = CUBE_POS_X * tile;
     let split = CUBE_POS_Z;
     let k_start = split * k_per_split;
     let k_end = select(k < k_start + k_per_split, k, k_start + k_per_split);
 
-    let mut a_tile = Shared::<[f32]>::new_slice(1024usize);
-    let mut b_tile = Shared::<[f32]>::new_slice(1024usize);
-    let mut acc = Array::<f32>::new(16usize);
+    let mut a_tile = Shared::<[f32]>::new_slice(comptime![(16 * (16 * per_unit + 1)) as usize]);
+    let mut b_tile = Shared::<[f32]>::new_slice(comptime![(16 * (16 * per_unit + 1)) as usize]);
+    let mut acc = Array::<f32>::new(comptime![(per_unit * per_unit) as usize]);
     #[unroll]
-    for e in 0..16usize {
-        acc[e] = 0.0;
+    for e in 0..per_unit * per_unit {
+        acc[e as usize] = 0.0;
     }
 
     for k0 in range_stepped(k_start, k_end, 16u32) {
+        // Each slab holds 16 x tile = 256 x per_unit elements: per_unit loads a unit.
         #[unroll]
-        for t in 0..4u32 {
+        for t in 0..per_unit {
             let e = lin + t * 256;
-            // A's slab, stored k-major: (r, kk) at kk * 64 + r.
-            let r = e / 16;
-            let kk = e % 16;
+            // A's slab, stored k-major: (r, kk) at kk * stride + r; neighbouring units take
+            // neighbouring k where A's rows are contiguous in memory, else neighbouring rows.
+            let mut r = e / 16;
+            let mut kk = e % 16;
+            if comptime![!a_rows_contiguous] {
+                r = e % tile;
+                kk = e / tile;
+            }
             let (gi, gk) = (row0 + r, k0 + kk);
             let mut va = 0.0f32;
             if gi < m && gk < k_end {
                 va = a[(gi * a_rs + gk * a_cs) as usize];
             }
-            a_tile[(kk * 64 + r) as usize] = va;
-            // B's slab: (kk, j) at kk * 64 + j.
-            let kb = e / 64;
-            let j = e % 64;
+            a_tile[(kk * stride + r) as usize] = va;
+            // B's slab: (kb, j) at kb * stride + j; neighbouring units take neighbouring
+            // columns where B's rows are contiguous, else neighbouring k.
+            let mut kb = e / tile;
+            let mut j = e % tile;
+            if comptime![!b_rows_contiguous] {
+                kb = e % 16;
+                j = e / 16;
+            }
             let (gkb, gj) = (k0 + kb, col0 + j);
             let mut vb = 0.0f32;
             if gkb < k_end && gj < n {
                 vb = b[(gkb * b_rs + gj * b_cs) as usize];
             }
-            b_tile[(kb * 64 + j) as usize] = vb;
+            b_tile[(kb * stride + j) as usize] = vb;
         }
         sync_cube();
         for kk in 0..16u32 {
-            let mut av = Array::<f32>::new(4usize);
-            let mut bv = Array::<f32>::new(4usize);
+            let mut av = Array::<f32>::new(comptime![per_unit as usize]);
+            let mut bv = Array::<f32>::new(comptime![per_unit as usize]);
             #[unroll]
-            for i in 0..4u32 {
-                av[i as usize] = a_tile[(kk * 64 + ty + i * 16) as usize];
-                bv[i as usize] = b_tile[(kk * 64 + tx + i * 16) as usize];
+            for i in 0..per_unit {
+                av[i as usize] = a_tile[(kk * stride + ty + i * 16) as usize];
+                bv[i as usize] = b_tile[(kk * stride + tx + i * 16) as usize];
             }
             #[unroll]
-            for i in 0..4u32 {
+            for i in 0..per_unit {
                 #[unroll]
-                for j in 0..4u32 {
-                    let at = (i * 4 + j) as usize;
+                for j in 0..per_unit {
+                    let at = (i * per_unit + j) as usize;
                     acc[at] += av[i as usize] * bv[j as usize];
                 }
             }
@@ -128,13 +171,13 @@ pub(crate) fn gemm_tiled(
 
     let base = split * m * n;
     #[unroll]
-    for i in 0..4u32 {
+    for i in 0..per_unit {
         #[unroll]
-        for j in 0..4u32 {
+        for j in 0..per_unit {
             let gi = row0 + ty + i * 16;
             let gj = col0 + tx + j * 16;
             if gi < m && gj < n {
-                let mut v = acc[(i * 4 + j) as usize];
+                let mut v = acc[(i * per_unit + j) as usize];
                 if comptime![epilogue >= 1] {
                     v += bias[gj as usize];
                 }
@@ -160,6 +203,8 @@ pub struct GemmShape {
     pub a_strides: (u32, u32),
     /// B's strides (row, column).
     pub b_strides: (u32, u32),
+    /// The tile of C a cube computes.
+    pub tiling: Tiling,
 }
 
 /// Launches `gemm_tiled`: `splits` partial products of `ceil(k / splits)` (rounded up to the k
@@ -183,7 +228,8 @@ pub unsafe fn launch_gemm(
 ) {
     let splits = splits.max(1);
     let per_split = shape.k.div_ceil(splits).div_ceil(K_STEP) * K_STEP;
-    let grid = CubeCount::Static(shape.n.div_ceil(TILE), shape.m.div_ceil(TILE), splits);
+    let tile = shape.tiling.tile();
+    let grid = CubeCount::Static(shape.n.div_ceil(tile), shape.m.div_ceil(tile), splits);
     let [la, lb, lbias, lc] = lens;
     unsafe {
         gemm_tiled::launch(
@@ -203,6 +249,10 @@ pub unsafe fn launch_gemm(
             shape.b_strides.1,
             per_split,
             epilogue.code(),
+            // "Rows contiguous": a row's elements are neighbours (column stride 1).
+            shape.a_strides.1 == 1,
+            shape.b_strides.1 == 1,
+            shape.tiling.per_unit(),
         );
     }
 }

@@ -5,9 +5,12 @@
 //! buffers. Every sum runs in an order fixed by the shapes alone, so the results are the same
 //! bits on every run of one device.
 
+use crate::gemm::Tiling;
 use crate::{elementwise, gemm, reduce};
 use cubecl::prelude::*;
 use cubecl::server::Handle;
+use std::cell::Cell;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// A row-major `rows x cols` f32 matrix on the device.
 #[derive(Clone, Debug)]
@@ -66,12 +69,76 @@ impl std::fmt::Display for ShapeError {
 
 impl std::error::Error for ShapeError {}
 
-/// The batch length of one split of a weight gradient's sum (as `cpu-kernels`' split-k).
-pub const SPLIT_LEN: u32 = 2048;
+/// The cubes a weight gradient's launch aims for (tiles x splits): about two for each
+/// multiprocessor of a large GPU (an H200 has 132), where one split per 2,048 rows left most of
+/// them idle.
+pub const TARGET_CUBES: u32 = 256;
+/// The fewest batch rows one split sums (unless the batch is shorter).
+pub const MIN_SPLIT_ROWS: u32 = 128;
 /// The most splits of one weight gradient.
-pub const MAX_SPLITS: u32 = 64;
+pub const MAX_SPLITS: u32 = 256;
+/// The batch rows of one block of the bias gradient's first pass.
+pub const BIAS_BLOCK_ROWS: u32 = 128;
 /// The most cubes along a grid axis the kernels launch (the limit of Vulkan and WebGPU).
 const MAX_CUBES: u32 = 65_535;
+
+/// 0: the default rule of [`splits`]; else a fixed split length ([`set_split_len`]).
+static SPLIT_LEN_NOW: AtomicU32 = AtomicU32::new(0);
+/// 0: [`Tiling::T64`], the default; 128: [`Tiling::T128`] ([`set_tiling`]).
+static TILING_NOW: AtomicU32 = AtomicU32::new(0);
+
+thread_local! {
+    static TILING_HERE: Cell<Option<Tiling>> = const { Cell::new(None) };
+}
+
+/// Sets a fixed batch length for every split of a weight gradient in this process (a power of
+/// two from 64 to 65,536; anything else is refused and changes nothing), or `None` for the
+/// default rule of [`splits`]. A tuning knob for benchmarks: the number of splits, and so the
+/// order of every sum, stays a function of the shapes and this setting.
+pub fn set_split_len(len: Option<u32>) -> Result<(), ShapeError> {
+    if let Some(len) = len {
+        check(len.is_power_of_two() && (64..=65_536).contains(&len), || {
+            format!("split length {len}: expected a power of two from 64 to 65536")
+        })?;
+    }
+    SPLIT_LEN_NOW.store(len.unwrap_or(0), Ordering::Relaxed);
+    Ok(())
+}
+
+/// Sets the tile of every product in this process (a tuning knob for benchmarks; the default
+/// is [`Tiling::T64`]).
+pub fn set_tiling(tiling: Tiling) {
+    let code = match tiling {
+        Tiling::T64 => 0,
+        Tiling::T128 => 128,
+    };
+    TILING_NOW.store(code, Ordering::Relaxed);
+}
+
+/// The tile of this thread's products: a [`TilingScope`]'s, else the process's.
+pub fn tiling() -> Tiling {
+    TILING_HERE.with(Cell::get).unwrap_or(match TILING_NOW.load(Ordering::Relaxed) {
+        128 => Tiling::T128,
+        _ => Tiling::T64,
+    })
+}
+
+/// Sets this thread's tile until dropped (tests run both tiles side by side).
+#[must_use = "the tile applies only while the scope lives"]
+pub struct TilingScope(Option<Tiling>);
+
+impl TilingScope {
+    /// This thread's products use `tiling` while the scope lives.
+    pub fn new(tiling: Tiling) -> Self {
+        Self(TILING_HERE.with(|t| t.replace(Some(tiling))))
+    }
+}
+
+impl Drop for TilingScope {
+    fn drop(&mut self) {
+        TILING_HERE.with(|t| t.set(self.0));
+    }
+}
 
 fn check(ok: bool, what: impl FnOnce() -> String) -> Result<(), ShapeError> {
     if ok { Ok(()) } else { Err(ShapeError(what())) }
@@ -92,7 +159,8 @@ pub fn forward(
     check(x.cols == w.rows, || {
         format!("linear forward: x is {} x {} but W is {} x {}", x.rows, x.cols, w.rows, w.cols)
     })?;
-    check_grid("linear forward", x.rows.div_ceil(gemm::TILE))?;
+    let tiling = tiling();
+    check_grid("linear forward", x.rows.div_ceil(tiling.tile()))?;
     let y = Matrix::empty(client, x.rows, w.cols);
     let epilogue = match (bias.is_some(), relu) {
         (false, false) => gemm::Epilogue::None,
@@ -108,6 +176,7 @@ pub fn forward(
         k: x.cols,
         a_strides: (x.cols, 1),
         b_strides: (w.cols, 1),
+        tiling,
     };
     let bias_handle = bias.cloned().unwrap_or_else(|| w.handle.clone());
     let bias_len = if bias.is_some() { w.cols as usize } else { 1 };
@@ -133,7 +202,8 @@ pub fn x_backward(client: &Client, w: &Matrix, dy: &Matrix) -> Result<Matrix, Sh
     check(dy.cols == w.cols, || {
         format!("input gradient: dY is {} x {} but W is {} x {}", dy.rows, dy.cols, w.rows, w.cols)
     })?;
-    check_grid("input gradient", dy.rows.div_ceil(gemm::TILE))?;
+    let tiling = tiling();
+    check_grid("input gradient", dy.rows.div_ceil(tiling.tile()))?;
     let dx = Matrix::empty(client, dy.rows, w.rows);
     let shape = gemm::GemmShape {
         m: dy.rows,
@@ -142,6 +212,7 @@ pub fn x_backward(client: &Client, w: &Matrix, dy: &Matrix) -> Result<Matrix, Sh
         a_strides: (dy.cols, 1),
         // Wᵀ (p, j) = W (j, p).
         b_strides: (1, w.cols),
+        tiling,
     };
     // SAFETY: as in `forward`.
     unsafe {
@@ -160,9 +231,25 @@ pub fn x_backward(client: &Client, w: &Matrix, dy: &Matrix) -> Result<Matrix, Sh
     Ok(dx)
 }
 
-/// The number of splits of a weight gradient's sum over `rows`: a function of `rows` alone.
-pub fn splits(rows: u32) -> u32 {
-    rows.div_ceil(SPLIT_LEN).clamp(1, MAX_SPLITS)
+/// The number of splits of a weight gradient's sum over `rows` whose `[d_in, d_out]` output
+/// takes `tiles` tiles: enough for [`TARGET_CUBES`] cubes in all, each split summing at least
+/// [`MIN_SPLIT_ROWS`] rows, at most [`MAX_SPLITS`] (or `rows / len` for a length set with
+/// [`set_split_len`]). A function of the shapes (and that setting) alone.
+pub fn splits(rows: u32, tiles: u32) -> u32 {
+    match SPLIT_LEN_NOW.load(Ordering::Relaxed) {
+        0 => {
+            let wanted = TARGET_CUBES.div_ceil(tiles.max(1));
+            wanted.min(rows / MIN_SPLIT_ROWS).clamp(1, MAX_SPLITS)
+        }
+        len => rows.div_ceil(len).clamp(1, MAX_SPLITS),
+    }
+}
+
+/// The blocks of the bias gradient's first pass over `rows`: one per [`BIAS_BLOCK_ROWS`]
+/// rows, at most [`MAX_SPLITS`] (each of its units then sums at most a few hundred values in
+/// either pass).
+pub fn bias_blocks(rows: u32) -> u32 {
+    rows.div_ceil(BIAS_BLOCK_ROWS).clamp(1, MAX_SPLITS)
 }
 
 /// The weight gradient `Xᵀ dY` `[d_in, d_out]` for x `[rows, d_in]` and dY `[rows, d_out]`:
@@ -171,7 +258,9 @@ pub fn weight_backward(client: &Client, x: &Matrix, dy: &Matrix) -> Result<Matri
     check(x.rows == dy.rows, || {
         format!("weight gradient: x is {} x {} but dY is {} x {}", x.rows, x.cols, dy.rows, dy.cols)
     })?;
-    let s = splits(x.rows);
+    let tiling = tiling();
+    let tile = tiling.tile();
+    let s = splits(x.rows, x.cols.div_ceil(tile) * dy.cols.div_ceil(tile));
     let shape = gemm::GemmShape {
         m: x.cols,
         n: dy.cols,
@@ -179,6 +268,7 @@ pub fn weight_backward(client: &Client, x: &Matrix, dy: &Matrix) -> Result<Matri
         // Xᵀ (i, p) = X (p, i).
         a_strides: (1, x.cols),
         b_strides: (dy.cols, 1),
+        tiling,
     };
     let dw = Matrix::empty(client, x.cols, dy.cols);
     let parts = if s == 1 { dw.clone() } else { Matrix::empty(client, s * x.cols, dy.cols) };
@@ -208,10 +298,10 @@ pub fn weight_backward(client: &Client, x: &Matrix, dy: &Matrix) -> Result<Matri
     Ok(dw)
 }
 
-/// The bias gradient: dY `[rows, d_out]` summed over its rows, in blocks of [`SPLIT_LEN`] rows
-/// added in order. Returns `d_out` floats.
+/// The bias gradient: dY `[rows, d_out]` summed over its rows, in [`bias_blocks`] blocks of
+/// rows added in order. Returns `d_out` floats.
 pub fn bias_backward(client: &Client, dy: &Matrix) -> Result<Matrix, ShapeError> {
-    let s = splits(dy.rows);
+    let s = bias_blocks(dy.rows);
     check_grid("bias gradient", dy.cols.div_ceil(reduce::UNITS))?;
     let db = Matrix::empty(client, 1, dy.cols);
     let parts = if s == 1 { db.clone() } else { Matrix::empty(client, s, dy.cols) };
@@ -255,4 +345,45 @@ pub fn relu_backward(client: &Client, x: &Matrix, grad: &Matrix) -> Result<Matri
         );
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The default rule fills the GPU; a set length is taken only when valid; a refused one
+    /// changes nothing. One test, because the settings are the process's.
+    #[test]
+    fn split_counts_follow_the_rule_and_the_setting() {
+        // A 128 x 128 gradient on 64-wide tiles (4 tiles) at 2^15: 64 splits of 512 rows.
+        assert_eq!(splits(32_768, 4), 64);
+        assert_eq!(splits(32_768, 1), 256);
+        assert_eq!(splits(8_192, 4), 64);
+        assert_eq!(splits(1_000, 4), 7);
+        assert_eq!(splits(1, 4), 1);
+        assert_eq!(splits(100_000, 1_000), 1);
+        assert_eq!(bias_blocks(32_768), 256);
+        assert_eq!(bias_blocks(1), 1);
+        for bad in [0, 1, 32, 100, 3000, 131_072] {
+            let e = set_split_len(Some(bad)).unwrap_err().to_string();
+            assert!(e.contains(&bad.to_string()) && e.contains("power of two"), "{e}");
+        }
+        assert_eq!(splits(32_768, 4), 64);
+        set_split_len(Some(2048)).unwrap();
+        assert_eq!(splits(32_768, 4), 16);
+        assert_eq!(splits(1, 4), 1);
+        set_split_len(None).unwrap();
+        assert_eq!(splits(32_768, 4), 64);
+    }
+
+    #[test]
+    fn a_tiling_scope_sets_this_thread_only_and_restores() {
+        assert_eq!(tiling(), Tiling::T64);
+        {
+            let _scope = TilingScope::new(Tiling::T128);
+            assert_eq!(tiling(), Tiling::T128);
+            std::thread::spawn(|| assert_eq!(tiling(), Tiling::T64)).join().unwrap();
+        }
+        assert_eq!(tiling(), Tiling::T64);
+    }
 }

@@ -1,12 +1,13 @@
 //! Each operation of `gpu_kernels::linear` against an f64 reference on the wgpu runtime (any
-//! Vulkan device; Mesa's lavapipe will do): shapes that fill the 64 x 64 tiles and shapes that
-//! do not, one split and many, NaN and negative inputs through the ReLU, the same bits on a
+//! Vulkan device; Mesa's lavapipe will do), on both tiles (64 and 128 wide): shapes that fill
+//! the tiles and shapes that do not, one split and many, NaN and negative inputs through the ReLU, the same bits on a
 //! second run, and shape errors that name the operation.
 //!
 //! `cargo test -p gpu-kernels --features wgpu`
 
 use cubecl::prelude::*;
-use gpu_kernels::linear::{self, Matrix};
+use gpu_kernels::gemm::Tiling;
+use gpu_kernels::linear::{self, Matrix, TilingScope};
 
 fn client() -> Client {
     cubecl::Device::Wgpu(Default::default()).client()
@@ -69,6 +70,13 @@ const SHAPES: [(u32, u32, u32); 5] =
 
 #[test]
 fn forward_matches_the_reference_with_and_without_bias_and_relu() {
+    for tiling in [Tiling::T64, Tiling::T128] {
+        let _scope = TilingScope::new(tiling);
+        forward_matches_on(tiling);
+    }
+}
+
+fn forward_matches_on(tiling: Tiling) {
     let client = client();
     for (t, &(rows, d_in, d_out)) in SHAPES.iter().enumerate() {
         let (m, k, n) = (rows as usize, d_in as usize, d_out as usize);
@@ -84,21 +92,29 @@ fn forward_matches_the_reference_with_and_without_bias_and_relu() {
         let relu: Vec<f64> = with_bias.iter().map(|v| v.max(0.0)).collect();
         let tol = 4e-7 * k as f64;
         let got = linear::forward(&client, &x, &w, None, false).unwrap().read(&client);
-        assert_close(&format!("x W {rows}x{d_in}x{d_out}"), &got, &plain, tol);
+        assert_close(&format!("x W {rows}x{d_in}x{d_out} {tiling:?}"), &got, &plain, tol);
         let got = linear::forward(&client, &x, &w, Some(&b.handle), false).unwrap();
         assert_close(
-            &format!("x W + b {rows}x{d_in}x{d_out}"),
+            &format!("x W + b {rows}x{d_in}x{d_out} {tiling:?}"),
             &got.read(&client),
             &with_bias,
             tol,
         );
         let got = linear::forward(&client, &x, &w, Some(&b.handle), true).unwrap();
-        assert_close(&format!("relu {rows}x{d_in}x{d_out}"), &got.read(&client), &relu, tol);
+        let label = format!("relu {rows}x{d_in}x{d_out} {tiling:?}");
+        assert_close(&label, &got.read(&client), &relu, tol);
     }
 }
 
 #[test]
 fn gradients_match_the_reference() {
+    for tiling in [Tiling::T64, Tiling::T128] {
+        let _scope = TilingScope::new(tiling);
+        gradients_match_on(tiling);
+    }
+}
+
+fn gradients_match_on(tiling: Tiling) {
     let client = client();
     for (t, &(rows, d_in, d_out)) in SHAPES.iter().enumerate() {
         let (m, k, n) = (rows as usize, d_in as usize, d_out as usize);
@@ -108,7 +124,7 @@ fn gradients_match_the_reference() {
         let x = Matrix::upload(&client, &xv, rows, d_in).unwrap();
         let w = Matrix::upload(&client, &wv, d_in, d_out).unwrap();
         let dy = Matrix::upload(&client, &dyv, rows, d_out).unwrap();
-        let label = format!("{rows}x{d_in}x{d_out}");
+        let label = format!("{rows}x{d_in}x{d_out} {tiling:?}");
 
         let dx = linear::x_backward(&client, &w, &dy).unwrap().read(&client);
         let want = product(&dyv, &transpose(&wv, k, n), m, n, k);
@@ -132,7 +148,8 @@ fn results_are_the_same_bits_on_a_second_run() {
     let dyv = values((rows * d_out) as usize, 8);
     let x = Matrix::upload(&client, &xv, rows, d_in).unwrap();
     let dy = Matrix::upload(&client, &dyv, rows, d_out).unwrap();
-    assert_eq!(linear::splits(rows), 10);
+    assert_eq!(linear::splits(rows, 4), 64);
+    assert_eq!(linear::bias_blocks(rows), 157);
     let first = linear::weight_backward(&client, &x, &dy).unwrap().read(&client);
     let second = linear::weight_backward(&client, &x, &dy).unwrap().read(&client);
     assert!(first.iter().zip(&second).all(|(a, b)| a.to_bits() == b.to_bits()));
