@@ -111,6 +111,14 @@ impl FmbrdfNets {
     ) -> Tensor<2> {
         let n = tan.dims()[0];
         assert_eq!(tan_host.len(), n, "FmbrdfNets::lambda: tan_host length");
+        // On a GPU, the dense network. The segments need the first layer's a and c on the host,
+        // a wait for the GPU in every step (which the training loop must not have), and the
+        // backward pass of their gather is a scatter-add of every row into at most 301. On an
+        // H200 FMBRDF's step took 73 to 78 ms at 2^15 with the segments, against PyTorch's 7.6
+        // (benches/README.md, 2026-11-28); the dense network's time there is not yet measured.
+        if crate::device::on_gpu(&tan) {
+            return self.lambda_dense(tan, alpha, beta);
+        }
         let (first, second) = (&self.lambda[0], &self.lambda[1]);
         let row = |k: usize| first.weight.clone().narrow(0, k, 1);
         // z1 = a + t c (the first layer's input is (alpha, beta, t, t alpha)).
