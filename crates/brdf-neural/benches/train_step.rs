@@ -446,6 +446,18 @@ fn bench(cr: &mut Criterion) {
             gf / square
         );
     }
+    if backends().into_iter().any(|b| b.is_gpu()) {
+        // On a GPU whose layers run on gpu-kernels, `split_k` leaves the layers whole.
+        use brdf_neural::gpu_linear::GpuLinear;
+        let layers = match GpuLinear::current() {
+            GpuLinear::Ours => {
+                "on gpu-kernels, whose weight gradients split inside their kernel: the GPU \
+                 rows' split column does not apply"
+            }
+            GpuLinear::Burn => "on burn's kernels, split by the trainer as the column says",
+        };
+        println!("(the GPU rows' linear layers ran {layers})");
+    }
     if !versus_pytorch.is_empty() {
         println!("\nThe step, back to back with PyTorch (medians of 10 steps; bf16 against");
         println!("PyTorch's bf16 autocast, then against PyTorch's f32 step timed right after it):");
