@@ -24,6 +24,8 @@ fi
 # (`--prepare`), so no xtask travels.
 cargo build --release -p sweep -p brdf-neural --features "$FEATURES" \
     --example profile_steps --bench train_step --test gpu_backend
+# One layer's products on gpu-kernels, unchecked and checked (the `checks` stage).
+cargo build --release -p gpu-kernels --features wgpu --bench layer
 # The weight-gradient products alone (the `cpu` stage), without wgpu.
 cargo build --release -p cpu-kernels --bench weight_gradient
 
@@ -33,6 +35,7 @@ cp target/release/examples/profile_steps $R/bin/
 cp "$(newest train_step)" $R/bin/train_step
 cp "$(newest gpu_backend)" $R/bin/gpu_backend
 cp "$(newest weight_gradient)" $R/bin/weight_gradient
+cp "$(newest layer)" $R/bin/layer
 strip $R/bin/*
 tar -cJf $R/bin.tar.xz -C $R bin
 rm -rf $R/bin

@@ -12,13 +12,14 @@
 //! 8.6 to 9.0 against 8.7), three times faster in a first process, before the autotune cache
 //! holds burn's shapes (4.6 against 14.2 ms), and its sums run in a fixed order.
 //!
-//! Two tuning settings of `ours`, for benchmarks, read (and a bad value refused) when a GPU
-//! device is made like the choice of kernels:
+//! Three settings of `ours`, for benchmarks and debugging, read (and a bad value refused) when
+//! a GPU device is made like the choice of kernels:
 //!
 //! | variable | values | default |
 //! | --- | --- | --- |
 //! | `NEURAL_BRDF_GPU_SPLIT_LEN` | batch rows each split of a weight gradient sums: a power of two from 64 to 65,536 | `gpu_kernels::linear::splits`' rule (enough splits for 256 cubes) |
 //! | `NEURAL_BRDF_GPU_TILE` | the products' tile: `64` or `128` | `64` |
+//! | `NEURAL_BRDF_GPU_CHECKED` | `1`: launch with CubeCL's index checks and wgpu's loop counters (`gpu_kernels::checks`), `0`: without | `0` |
 
 use std::sync::OnceLock;
 
@@ -93,7 +94,22 @@ pub fn parse_tile(value: &str) -> crate::Result<u32> {
     }
 }
 
-/// Reads [`VAR`], [`SPLIT_VAR`] and [`TILE_VAR`] when a GPU device is made: an unknown value
+/// The environment variable that launches `ours`' kernels with CubeCL's index checks.
+pub const CHECKED_VAR: &str = "NEURAL_BRDF_GPU_CHECKED";
+
+/// Parses `0` or `1` (whether the kernels launch checked).
+pub fn parse_checked(value: &str) -> crate::Result<bool> {
+    match value.trim() {
+        "0" => Ok(false),
+        "1" => Ok(true),
+        _ => Err(crate::Error::Setting(format!(
+            "{CHECKED_VAR}={value:?}: expected 1 (launch the GPU kernels with index checks, a \
+             debugging aid) or 0 (without, the default)"
+        ))),
+    }
+}
+
+/// Reads [`VAR`], [`SPLIT_VAR`], [`TILE_VAR`] and [`CHECKED_VAR`] when a GPU device is made: an unknown value
 /// is an error naming its variable; the tuning settings are handed to the kernels.
 #[cfg(any(feature = "wgpu", feature = "cuda"))]
 pub(crate) fn configure() -> crate::Result<()> {
@@ -109,6 +125,9 @@ pub(crate) fn configure() -> crate::Result<()> {
             _ => gpu_kernels::gemm::Tiling::T64,
         };
         gpu_kernels::linear::set_tiling(tiling);
+    }
+    if let Ok(value) = std::env::var(CHECKED_VAR) {
+        gpu_kernels::checks::set_checked(parse_checked(&value)?);
     }
     Ok(())
 }
@@ -144,6 +163,16 @@ mod tests {
         for bad in ["32", "256", "wide", ""] {
             let e = parse_tile(bad).unwrap_err().to_string();
             assert!(e.contains(TILE_VAR) && e.contains("128"), "{e}");
+        }
+    }
+
+    #[test]
+    fn checked_parses_and_bad_values_name_the_variable() {
+        assert!(parse_checked("1").unwrap());
+        assert!(!parse_checked(" 0 ").unwrap());
+        for bad in ["yes", "2", ""] {
+            let e = parse_checked(bad).unwrap_err().to_string();
+            assert!(e.contains(CHECKED_VAR) && e.contains("expected 1"), "{e}");
         }
     }
 }

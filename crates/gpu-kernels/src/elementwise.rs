@@ -7,7 +7,7 @@ use cubecl::prelude::*;
 pub const UNITS: u32 = 256;
 
 /// `out[i] = grad[i]` where `!(x[i] <= 0)`, else 0.
-#[cube(launch)]
+#[cube(launch, launch_unchecked)]
 pub(crate) fn relu_backward(x: &[f32], grad: &[f32], out: &mut [f32], len: u32) {
     let i = ABSOLUTE_POS_X;
     if i < len {
@@ -32,7 +32,8 @@ pub unsafe fn launch_relu_backward(
     len: u32,
 ) {
     unsafe {
-        relu_backward::launch(
+        crate::checks::launch!(
+            relu_backward,
             client,
             CubeCount::Static(len.div_ceil(UNITS), 1, 1),
             CubeDim::new_1d(UNITS),

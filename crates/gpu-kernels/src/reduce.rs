@@ -9,7 +9,7 @@ use cubecl::prelude::*;
 pub const UNITS: u32 = 256;
 
 /// `out[i] = parts[i] + parts[len + i] + ... + parts[(count - 1) len + i]`, in that order.
-#[cube(launch)]
+#[cube(launch, launch_unchecked)]
 pub(crate) fn sum_parts(parts: &[f32], out: &mut [f32], count: u32, len: u32) {
     let i = ABSOLUTE_POS_X;
     if i < len {
@@ -24,7 +24,7 @@ pub(crate) fn sum_parts(parts: &[f32], out: &mut [f32], count: u32, len: u32) {
 /// `partials[p n + j]` = the sum of column j of the row-major m x n matrix `x` over rows
 /// `p rows_per_part .. (p + 1) rows_per_part`, in row order. Launched on
 /// `(ceil(n / 256), parts)` cubes of 256 units.
-#[cube(launch)]
+#[cube(launch, launch_unchecked)]
 pub(crate) fn column_partial_sums(
     x: &[f32],
     partials: &mut [f32],
@@ -57,7 +57,8 @@ pub unsafe fn launch_sum_parts(
     len: u32,
 ) {
     unsafe {
-        sum_parts::launch(
+        crate::checks::launch!(
+            sum_parts,
             client,
             CubeCount::Static(len.div_ceil(UNITS), 1, 1),
             CubeDim::new_1d(UNITS),
@@ -83,7 +84,8 @@ pub unsafe fn launch_column_partial_sums(
 ) {
     let rows_per_part = m.div_ceil(parts.max(1)).max(1);
     unsafe {
-        column_partial_sums::launch(
+        crate::checks::launch!(
+            column_partial_sums,
             client,
             CubeCount::Static(n.div_ceil(UNITS), parts.max(1), 1),
             CubeDim::new_1d(UNITS),

@@ -1,11 +1,12 @@
 //! Each operation of `gpu_kernels::linear` against an f64 reference on the wgpu runtime (any
 //! Vulkan device; Mesa's lavapipe will do), on both tiles (64 and 128 wide): shapes that fill
 //! the tiles and shapes that do not, one split and many, NaN and negative inputs through the ReLU, the same bits on a
-//! second run, and shape errors that name the operation.
+//! second run, the same bits from checked launches, and shape errors that name the operation.
 //!
 //! `cargo test -p gpu-kernels --features wgpu`
 
 use cubecl::prelude::*;
+use gpu_kernels::checks;
 use gpu_kernels::gemm::Tiling;
 use gpu_kernels::linear::{self, Matrix, TilingScope};
 
@@ -156,6 +157,46 @@ fn results_are_the_same_bits_on_a_second_run() {
     let first = linear::bias_backward(&client, &dy).unwrap().read(&client);
     let second = linear::bias_backward(&client, &dy).unwrap().read(&client);
     assert!(first.iter().zip(&second).all(|(a, b)| a.to_bits() == b.to_bits()));
+}
+
+/// Every operation's outputs, on shapes that fill no tile, with one tile.
+fn all_outputs(client: &Client, tiling: Tiling) -> Vec<Vec<f32>> {
+    let _scope = TilingScope::new(tiling);
+    let (rows, d_in, d_out) = (1_000u32, 70u32, 50u32);
+    let x = Matrix::upload(client, &values((rows * d_in) as usize, 11), rows, d_in).unwrap();
+    let w = Matrix::upload(client, &values((d_in * d_out) as usize, 12), d_in, d_out).unwrap();
+    let b = Matrix::upload(client, &values(d_out as usize, 13), 1, d_out).unwrap();
+    let dy = Matrix::upload(client, &values((rows * d_out) as usize, 14), rows, d_out).unwrap();
+    let y = linear::forward(client, &x, &w, Some(&b.handle), true).unwrap();
+    vec![
+        y.read(client),
+        linear::x_backward(client, &w, &dy).unwrap().read(client),
+        linear::weight_backward(client, &x, &dy).unwrap().read(client),
+        linear::bias_backward(client, &dy).unwrap().read(client),
+        linear::relu_backward(client, &y, &dy).unwrap().read(client),
+    ]
+}
+
+#[test]
+fn checked_launches_give_the_same_bits_as_unchecked_ones() {
+    // The kernels guard their own indices, so CubeCL's checks (a debugging aid) change
+    // nothing. The setting is process-wide: another test running meanwhile may run checked,
+    // which by this very property changes none of its results.
+    let client = client();
+    for tiling in [Tiling::T64, Tiling::T128] {
+        assert!(!checks::checked(), "unchecked is the default");
+        let unchecked = all_outputs(&client, tiling);
+        checks::set_checked(true);
+        let checked = all_outputs(&client, tiling);
+        checks::set_checked(false);
+        for (op, (u, c)) in unchecked.iter().zip(&checked).enumerate() {
+            assert_eq!(u.len(), c.len(), "operation {op}");
+            assert!(
+                u.iter().zip(c).all(|(a, b)| a.to_bits() == b.to_bits()),
+                "operation {op} on {tiling:?}: checked and unchecked launches differ"
+            );
+        }
+    }
 }
 
 #[test]

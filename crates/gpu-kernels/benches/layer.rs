@@ -1,0 +1,92 @@
+//! One 128-wide hidden layer of a training step on the first wgpu device: the forward product
+//! (bias and ReLU fused), the input gradient and the weight gradient (split-K), each launched
+//! unchecked (the default) and checked (CubeCL's index checks and wgpu's loop counters, see
+//! `gpu_kernels::checks`), back to back in the same run. Every timed call ends by waiting for
+//! the device.
+//!
+//! `cargo bench -p gpu-kernels --features wgpu --bench layer`. Environment:
+//! `GPU_KERNELS_BENCH_ROWS` (default 8192: Mesa's lavapipe runs on the CPU; 32768 is the
+//! training step's batch on a GPU). A summary line per operation gives GFLOP/s (2 m n k) and
+//! the checked/unchecked time ratio.
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use cubecl::prelude::*;
+use gpu_kernels::checks;
+use gpu_kernels::linear::{self, Matrix};
+use std::time::Instant;
+
+const WIDTH: u32 = 128;
+
+fn rows() -> u32 {
+    std::env::var("GPU_KERNELS_BENCH_ROWS").ok().and_then(|s| s.parse().ok()).unwrap_or(8_192)
+}
+
+fn values(len: usize, salt: usize) -> Vec<f32> {
+    (0..len).map(|i| ((i * 37 + salt) % 101) as f32 / 50.0 - 1.0).collect()
+}
+
+fn wait(client: &Client) {
+    cubecl::future::block_on(client.sync()).expect("the device is lost");
+}
+
+type Op = fn(&Client, &Matrix, &Matrix, &Matrix, &Handle) -> Matrix;
+type Handle = cubecl::server::Handle;
+
+const OPS: [(&str, Op); 3] = [
+    ("forward", |c, x, w, _, b| linear::forward(c, x, w, Some(b), true).unwrap()),
+    ("input gradient", |c, _, w, dy, _| linear::x_backward(c, w, dy).unwrap()),
+    ("weight gradient", |c, x, _, dy, _| linear::weight_backward(c, x, dy).unwrap()),
+];
+
+fn layer(c: &mut Criterion) {
+    let client = cubecl::Device::Wgpu(Default::default()).client();
+    let rows = rows();
+    let x = Matrix::upload(&client, &values((rows * WIDTH) as usize, 1), rows, WIDTH).unwrap();
+    let w = Matrix::upload(&client, &values((WIDTH * WIDTH) as usize, 2), WIDTH, WIDTH).unwrap();
+    let b = Matrix::upload(&client, &values(WIDTH as usize, 3), 1, WIDTH).unwrap();
+    let dy = Matrix::upload(&client, &values((rows * WIDTH) as usize, 4), rows, WIDTH).unwrap();
+    let flop = 2.0 * rows as f64 * WIDTH as f64 * WIDTH as f64;
+    let mut group = c.benchmark_group(format!("layer_{rows}x{WIDTH}x{WIDTH}"));
+    group.sample_size(10);
+    let mut summary = Vec::new();
+    for (name, op) in OPS {
+        let mut seconds = [0.0f64; 2];
+        for (mode, checked) in [(0, false), (1, true)] {
+            checks::set_checked(checked);
+            // Compiles the kernel outside the timing.
+            op(&client, &x, &w, &dy, &b.handle);
+            wait(&client);
+            let label = if checked { "checked" } else { "unchecked" };
+            group.bench_function(BenchmarkId::new(name, label), |bench| {
+                bench.iter(|| {
+                    op(&client, &x, &w, &dy, &b.handle);
+                    wait(&client);
+                })
+            });
+            let reps = 5;
+            let t = Instant::now();
+            for _ in 0..reps {
+                op(&client, &x, &w, &dy, &b.handle);
+            }
+            wait(&client);
+            seconds[mode] = t.elapsed().as_secs_f64() / reps as f64;
+        }
+        summary.push(format!(
+            "{name}: unchecked {:.2} ms ({:.1} GFLOP/s), checked {:.2} ms ({:.1} GFLOP/s), \
+             checked/unchecked {:.2}",
+            1e3 * seconds[0],
+            flop / seconds[0] / 1e9,
+            1e3 * seconds[1],
+            flop / seconds[1] / 1e9,
+            seconds[1] / seconds[0],
+        ));
+    }
+    checks::set_checked(false);
+    group.finish();
+    for line in summary {
+        eprintln!("{line}");
+    }
+}
+
+criterion_group!(benches, layer);
+criterion_main!(benches);
