@@ -149,8 +149,9 @@ pub(crate) fn gemm_tiled(
             b_tile[(kb * stride + j) as usize] = vb;
         }
         sync_cube();
-        // Unrolled: the shared-memory offsets become constants and the 16 steps' loads can
-        // be issued ahead of their sums.
+        // Not unrolled in the source (on lavapipe that made the tests' shader compiles 30
+        // times slower); launched unchecked, the loop has no counter that keeps the driver
+        // from unrolling it.
         for kk in 0..16u32 {
             let mut av = Array::<f32>::new(comptime![per_unit as usize]);
             let mut bv = Array::<f32>::new(comptime![per_unit as usize]);
