@@ -210,25 +210,31 @@ fn monte_carlo_group(
     while done < samples {
         let m = block.min(samples - done);
         let n = m * pairs.len();
-        let (mut pts, mut ls, mut vs) =
-            (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
-        for ((_, p), rng) in pairs.iter().zip(&mut rngs) {
-            for _ in 0..m {
+        // Each pair's block of samples from its own generator, the pairs on every thread (the
+        // same numbers in any order: a model evaluated on a GPU leaves the host the sampling).
+        let mut vs = vec![[0.0f32; 3]; n];
+        vs.par_chunks_mut(m).zip(rngs.par_iter_mut()).for_each(|(vs, rng)| {
+            for v in vs {
                 let (u1, u2): (f64, f64) = (rng.random(), rng.random());
-                pts.push(p.point);
-                ls.push(p.l);
-                vs.push(cosine_direction(u1, u2));
+                *v = cosine_direction(u1, u2);
             }
-        }
+        });
+        let pts: Vec<u32> =
+            pairs.iter().flat_map(|(_, p)| std::iter::repeat_n(p.point, m)).collect();
+        let ls: Vec<[f32; 3]> =
+            pairs.iter().flat_map(|(_, p)| std::iter::repeat_n(p.l, m)).collect();
         let f = eval_chunked(brdf, &pts, &ls, &vs, batch);
-        for (k, fk) in f.iter().enumerate() {
-            let j = k / m;
-            for c in 0..3 {
-                let x = fk[c] as f64;
-                sum[j][c] += x;
-                sq[j][c] += x * x;
-            }
-        }
+        f.par_chunks(m).zip(sum.par_iter_mut().zip(sq.par_iter_mut())).for_each(
+            |(f, (sum, sq))| {
+                for fk in f {
+                    for c in 0..3 {
+                        let x = fk[c] as f64;
+                        sum[c] += x;
+                        sq[c] += x * x;
+                    }
+                }
+            },
+        );
         done += m;
     }
     let pi = std::f64::consts::PI;

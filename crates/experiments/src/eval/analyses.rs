@@ -15,7 +15,7 @@ pub fn energy(
     progress: bool,
 ) -> Result<Option<EnergySummary>> {
     let Some(estimator) = settings.energy else { return Ok(None) };
-    let data = brdf.data;
+    let data = brdf.data();
     if data.is_empty() {
         return Ok(None);
     }
@@ -39,7 +39,7 @@ pub fn energy(
 /// The reciprocity RMSE over the first `settings.reciprocity_pairs` test records spread over
 /// the whole set (every k-th), `None` when off.
 pub fn reciprocity(brdf: &ModelBrdf, settings: &EvalSettings) -> Result<Option<f64>> {
-    let data = brdf.data;
+    let data = brdf.data();
     let n = settings.reciprocity_pairs.min(data.len());
     if n == 0 {
         return Ok(None);

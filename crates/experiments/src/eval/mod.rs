@@ -58,8 +58,7 @@ pub fn energy_of_run(
     let settings = eval.resolve(run.config.train.profile);
     let (_, data) = run.test_records()?;
     let config = &run.config;
-    let brdf =
-        ModelBrdf { model: &run.model, config: &config.model, data: &data, device: &run.device };
+    let brdf = ModelBrdf::new(&run.model, &config.model, &data, &run.device)?;
     analyses::energy(&brdf, &settings, config.seed, progress)
 }
 
@@ -183,7 +182,7 @@ pub fn eval_fitted(
         (None, None) => {}
     }
     charge(&mut phases.images);
-    let brdf = ModelBrdf { model, config: &config.model, data: &data, device };
+    let brdf = ModelBrdf::new(model, &config.model, &data, device)?;
     let reciprocity_rmse = analyses::reciprocity(&brdf, &settings)?;
     charge(&mut phases.reciprocity);
     let energy = analyses::energy(&brdf, &settings, config.seed, progress)?;

@@ -3,7 +3,7 @@
 
 use crate::data::TrainingData;
 use crate::{Error, Result};
-use brdf_neural::{BrdfBatch, BrdfModel, ModelConfig, Samples, split_k};
+use brdf_neural::{BrdfBatch, BrdfModel, ModelConfig, Samples, SpatialTable, split_k};
 use burn::tensor::{Device, Tensor};
 
 /// Rows per forward pass.
@@ -66,13 +66,42 @@ pub fn forward_rows(
     // On a GPU, the training loop's parts of 512 rows (`split_k::gpu_parts`): every pass of
     // an evaluation then meets the matrix-product shapes that training tuned.
     let _split = gpu.then(|| split_k::scope(split_k::gpu_parts(rows)));
-    forward_padded(model, config, samples, device, parts, rows)
+    forward_padded(model, config, Spatial::Rows, samples, device, parts, rows)
 }
 
-/// [`forward_rows`] run on `padded_n` (at least the samples') rows.
+/// [`forward_rows`] with each sample's spatial row selected on the device: row `points[i]`
+/// of `table` for sample i (the same values as [`forward_rows`] with those rows gathered on
+/// the CPU, without copying a row per sample and uploading it).
+pub fn forward_points(
+    model: &BrdfModel,
+    config: &ModelConfig,
+    table: &SpatialTable,
+    points: &[u32],
+    l: &[[f32; 3]],
+    v: &[[f32; 3]],
+    device: &Device,
+) -> Result<Prediction> {
+    let gpu = !brdf_neural::device::is_cpu_device(device);
+    let rows = pass_rows(l.len(), gpu);
+    let _split = gpu.then(|| split_k::scope(split_k::gpu_parts(rows)));
+    let samples = Samples { spatial: &[], l, v };
+    forward_padded(model, config, Spatial::Table(table, points), &samples, device, false, rows)
+}
+
+/// Where a pass's spatial rows come from.
+#[derive(Clone, Copy)]
+enum Spatial<'a> {
+    /// The samples' own rows, on the CPU.
+    Rows,
+    /// Rows of a table on the device, one index a sample.
+    Table(&'a SpatialTable, &'a [u32]),
+}
+
+/// [`forward_rows`] (or [`forward_points`]) run on `padded_n` (at least the samples') rows.
 fn forward_padded(
     model: &BrdfModel,
     config: &ModelConfig,
+    source: Spatial,
     samples: &Samples,
     device: &Device,
     parts: bool,
@@ -80,22 +109,29 @@ fn forward_padded(
 ) -> Result<Prediction> {
     let n = samples.l.len();
     let pad = padded_n.saturating_sub(n);
-    // Padding rows: zero features and a valid (l, v) pair; their outputs are dropped.
-    let mut spatial = Vec::with_capacity(samples.spatial.len() + pad * config.spatial_dim);
-    spatial.extend_from_slice(samples.spatial);
-    spatial.resize(spatial.len() + pad * config.spatial_dim, 0.0);
+    // Padding rows: zero features (or the table's first row) and a valid (l, v) pair; their
+    // outputs are dropped.
     let padded = |d: &[[f32; 3]]| [d, &vec![[0.0, 0.0, 1.0]; pad]].concat();
-    let batch = if pad == 0 {
-        BrdfBatch::from_owned(config, spatial, samples.l, samples.v, None, device)?
+    let (l, v) = if pad == 0 {
+        (std::borrow::Cow::Borrowed(samples.l), std::borrow::Cow::Borrowed(samples.v))
     } else {
-        BrdfBatch::from_owned(
-            config,
-            spatial,
-            &padded(samples.l),
-            &padded(samples.v),
-            None,
-            device,
-        )?
+        (padded(samples.l).into(), padded(samples.v).into())
+    };
+    let batch = match source {
+        Spatial::Rows => {
+            let mut spatial = Vec::with_capacity(samples.spatial.len() + pad * config.spatial_dim);
+            spatial.extend_from_slice(samples.spatial);
+            spatial.resize(spatial.len() + pad * config.spatial_dim, 0.0);
+            BrdfBatch::from_owned(config, spatial, &l, &v, None, device)?
+        }
+        Spatial::Table(table, points) => {
+            let points = if pad == 0 {
+                std::borrow::Cow::Borrowed(points)
+            } else {
+                [points, &vec![0; pad]].concat().into()
+            };
+            BrdfBatch::from_table(config, table, &points, &l, &v, None, device)?
+        }
     };
     let rows = |t: Tensor<2>, what: &str| -> Result<Vec<[f32; 3]>> {
         let mut r = rows(t, what)?;
@@ -147,36 +183,79 @@ pub fn predict(
     Ok(all)
 }
 
+/// Rows per pass of [`ModelBrdf`] on a GPU: eight of [`CHUNK`]. The energy analysis then
+/// evaluates 13 of the paper's pairs (20,000 samples each) a pass, and the host samples their
+/// directions on every core while the device runs (a pair a pass, at [`CHUNK`], left one
+/// core sampling and a readback every 20,000 evaluations).
+pub const GPU_BATCH: usize = 8 * CHUNK;
+
 /// A fitted model as a [`metrics::BatchBrdf`]: point `i` is record `i` of `data` (its spatial
 /// features); directions are the analyses' local-frame ones. Evaluation errors (which cannot
 /// happen for a model that loaded) surface as NaN, which the analyses reject.
+///
+/// On a GPU the spatial rows of `data`'s points live on the device
+/// ([`crate::trainer::device_table`]), and each pass selects its rows there: the analyses
+/// evaluate a point thousands of times (the paper's energy protocol 20,000 times a pair), and
+/// copying its row (160 floats at 512 px) for every evaluation would make the host, not the
+/// device, set the pace.
 pub struct ModelBrdf<'a> {
-    /// The model.
-    pub model: &'a BrdfModel,
-    /// Its configuration (feature construction).
-    pub config: &'a ModelConfig,
+    model: &'a BrdfModel,
+    config: &'a ModelConfig,
+    data: &'a TrainingData,
+    device: &'a Device,
+    gpu: bool,
+    table: Option<SpatialTable>,
+}
+
+impl<'a> ModelBrdf<'a> {
+    /// The model on the records of `data`, their spatial rows uploaded on a GPU.
+    pub fn new(
+        model: &'a BrdfModel,
+        config: &'a ModelConfig,
+        data: &'a TrainingData,
+        device: &'a Device,
+    ) -> Result<Self> {
+        let gpu = !brdf_neural::device::is_cpu_device(device);
+        let table = crate::trainer::device_table(config, data, gpu, device)?;
+        Ok(Self { model, config, data, device, gpu, table })
+    }
+
     /// The records whose spatial features the points index.
-    pub data: &'a TrainingData,
-    /// Device of the model.
-    pub device: &'a Device,
+    pub fn data(&self) -> &'a TrainingData {
+        self.data
+    }
+
+    /// Whether the spatial rows are selected on the device.
+    pub fn rows_on_device(&self) -> bool {
+        self.table.is_some()
+    }
 }
 
 impl metrics::BatchBrdf for ModelBrdf<'_> {
     fn eval_batch(&self, points: &[u32], l: &[[f32; 3]], v: &[[f32; 3]], out: &mut [[f32; 3]]) {
-        let k = self.data.spatial_dim;
-        let mut spatial = Vec::with_capacity(points.len() * k);
-        for &p in points {
-            spatial.extend_from_slice(self.data.spatial_row(p as usize));
-        }
-        let samples = Samples { spatial: &spatial, l, v };
-        match forward_rows(self.model, self.config, &samples, self.device, false) {
+        let p = match &self.table {
+            Some(table) => {
+                let rows: Vec<u32> = points.iter().map(|&p| self.data.point[p as usize]).collect();
+                forward_points(self.model, self.config, table, &rows, l, v, self.device)
+            }
+            None => {
+                let k = self.data.spatial_dim;
+                let mut spatial = Vec::with_capacity(points.len() * k);
+                for &p in points {
+                    spatial.extend_from_slice(self.data.spatial_row(p as usize));
+                }
+                let samples = Samples { spatial: &spatial, l, v };
+                forward_rows(self.model, self.config, &samples, self.device, false)
+            }
+        };
+        match p {
             Ok(p) => out.copy_from_slice(&p.f),
             Err(_) => out.fill([f32::NAN; 3]),
         }
     }
 
     fn preferred_batch(&self) -> usize {
-        CHUNK
+        if self.gpu { GPU_BATCH } else { CHUNK }
     }
 
     /// The backend parallelises each forward pass itself.
@@ -224,8 +303,11 @@ mod tests {
             let n = 37;
             let (spatial, l, v) = inputs(n);
             let samples = Samples { spatial: &spatial, l: &l, v: &v };
-            let plain = forward_padded(&model, &config, &samples, &device, true, n).unwrap();
-            let padded = forward_padded(&model, &config, &samples, &device, true, 1024).unwrap();
+            let plain =
+                forward_padded(&model, &config, Spatial::Rows, &samples, &device, true, n).unwrap();
+            let padded =
+                forward_padded(&model, &config, Spatial::Rows, &samples, &device, true, 1024)
+                    .unwrap();
             let specular = (plain.specular.as_ref(), padded.specular.as_ref());
             assert_eq!(specular.0.is_some(), kind.is_additive());
             assert_eq!(specular.1.is_some(), kind.is_additive());
@@ -263,6 +345,77 @@ mod tests {
                 for (x, y) in want.iter().flatten().zip(got.iter().flatten()) {
                     assert!((x - y).abs() <= 1e-4 * x.abs().max(1e-3), "{kind:?}: {x} against {y}");
                 }
+            }
+        }
+    }
+
+    /// Records whose points repeat: 7 points, 40 records.
+    fn records(config: &ModelConfig) -> TrainingData {
+        let (spatial, _, _) = inputs(7);
+        let (_, l, v) = inputs(40);
+        TrainingData {
+            spatial: std::sync::Arc::new(spatial),
+            spatial_dim: config.spatial_dim,
+            point: (0..40).map(|i| (i * 3 % 7) as u32).collect(),
+            l,
+            v,
+            ..Default::default()
+        }
+    }
+
+    /// Evaluates records 39, 0, 5, ... of `data` through [`metrics::BatchBrdf`].
+    fn as_batch_brdf(brdf: &ModelBrdf, data: &TrainingData) -> Vec<[f32; 3]> {
+        use metrics::BatchBrdf;
+        let records: Vec<u32> = (0..40).map(|i| (39 + 5 * i) % 40).collect();
+        let l: Vec<[f32; 3]> = records.iter().map(|&r| data.l[r as usize]).collect();
+        let v: Vec<[f32; 3]> = records.iter().map(|&r| data.v[r as usize]).collect();
+        let mut out = vec![[0.0; 3]; records.len()];
+        brdf.eval_batch(&records, &l, &v, &mut out);
+        out
+    }
+
+    #[test]
+    fn the_model_as_a_batch_brdf_reads_each_records_point_on_the_cpu() {
+        let device = brdf_neural::device::cpu();
+        let config = ModelConfig { spatial_dim: 4, ..ModelConfig::new(ModelKind::SingleMlp) };
+        let model = BrdfModel::init(&config, &device).unwrap();
+        let data = records(&config);
+        let brdf = ModelBrdf::new(&model, &config, &data, &device).unwrap();
+        assert!(!brdf.rows_on_device());
+        assert_eq!(metrics::BatchBrdf::preferred_batch(&brdf), CHUNK);
+        let got = as_batch_brdf(&brdf, &data);
+        for (i, g) in got.iter().enumerate() {
+            let r = (39 + 5 * i) % 40;
+            let samples = Samples {
+                spatial: data.spatial_row(r),
+                l: &data.l[r..r + 1],
+                v: &data.v[r..r + 1],
+            };
+            let want = forward_rows(&model, &config, &samples, &device, false).unwrap().f[0];
+            assert_eq!(*g, want, "record {r}");
+        }
+    }
+
+    /// On a GPU the records' rows are selected from a table on the device: the CPU's values.
+    #[cfg(feature = "wgpu")]
+    #[test]
+    fn the_model_as_a_batch_brdf_selects_rows_on_the_gpu() {
+        use brdf_neural::device::Backend;
+        use burn::module::Module;
+        let cpu = brdf_neural::device::cpu();
+        let gpu = Backend::Wgpu.device().unwrap();
+        for kind in [ModelKind::SingleMlp, ModelKind::Disney] {
+            let config = ModelConfig { spatial_dim: 4, ..ModelConfig::new(kind) };
+            let model = BrdfModel::init(&config, &cpu).unwrap();
+            let on_gpu = model.clone().fork(&gpu);
+            let data = records(&config);
+            let want = as_batch_brdf(&ModelBrdf::new(&model, &config, &data, &cpu).unwrap(), &data);
+            let brdf = ModelBrdf::new(&on_gpu, &config, &data, &gpu).unwrap();
+            assert!(brdf.rows_on_device());
+            assert_eq!(metrics::BatchBrdf::preferred_batch(&brdf), GPU_BATCH);
+            let got = as_batch_brdf(&brdf, &data);
+            for (x, y) in want.iter().flatten().zip(got.iter().flatten()) {
+                assert!((x - y).abs() <= 1e-4 * x.abs().max(1e-3), "{kind:?}: {x} against {y}");
             }
         }
     }

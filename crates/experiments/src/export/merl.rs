@@ -109,12 +109,7 @@ pub fn export_merl(
         point: vec![0],
         ..Default::default()
     };
-    let brdf = ModelBrdf {
-        model: &fitted.model,
-        config: &config.model,
-        data: &data,
-        device: &fitted.device,
-    };
+    let brdf = ModelBrdf::new(&fitted.model, &config.model, &data, &fitted.device)?;
     let (merl, below_horizon) = tabulate_merl(&brdf, 0, progress)?;
     merl.write(out).map_err(|e| Error::format(out, e.to_string()))?;
     Ok(MerlExport {
