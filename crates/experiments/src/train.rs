@@ -248,6 +248,9 @@ pub fn fit_and_keep(
     let bar = progress_bar(options.progress, t.iterations, state.step);
     let on_device = options.inputs_on_device.unwrap_or(options.backend.is_gpu());
     let spatial = device_table(&config.model, &data, on_device, &device)?;
+    let has_val = !val.is_empty();
+    let val_spatial =
+        device_table(&config.model, &val, on_device && has_val, &device.clone().inner())?;
     let gpu_reads = if options.backend.is_gpu() { GPU_LOSS_READS } else { 1 };
     let loss_reads = options.loss_reads.or(loss_reads_from_env()?).unwrap_or(gpu_reads).max(1);
     let records = device_records(&config.model, &data, spatial.as_ref(), on_device, &device)?;
@@ -258,6 +261,7 @@ pub fn fit_and_keep(
         val: &val,
         device,
         spatial,
+        val_spatial,
         records,
         bar,
         loss_reads,

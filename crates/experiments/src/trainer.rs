@@ -53,6 +53,9 @@ pub(crate) struct Loop<'a> {
     /// On a GPU: the spatial rows of every point, on the device, where each batch selects its
     /// rows ([`device_table`]); `None`: batches gather them on the CPU.
     pub spatial: Option<SpatialTable>,
+    /// On a GPU: the same rows on the inference device, where validation selects its records'
+    /// rows (validation and training records share their points).
+    pub val_spatial: Option<SpatialTable>,
     /// The progress bar (hidden when not shown).
     pub bar: ProgressBar,
     /// On a GPU: every record's direction inputs, weights and targets on the device, where each
@@ -355,7 +358,9 @@ impl Loop<'_> {
         }
         // In f32 even when the steps run bf16 products: the plateau rule compares these losses.
         let f32_products = brdf_neural::precision::MatmulPrecision::f32_scope();
-        let v = validation_loss(model, self.config, self.val, &self.device.clone().inner())?;
+        let inference = self.device.clone().inner();
+        let table = self.val_spatial.as_ref();
+        let v = validation_loss(model, self.config, self.val, table, &inference)?;
         drop(f32_products);
         match state.plateau.update(state.step, v, t) {
             Decision::Stop => state.stopped = Some(StopReason::Plateau),
@@ -468,14 +473,17 @@ pub fn device_table(
 }
 
 /// The gamma-MSE of `model` on the records `val` (no regularisers), computed in inference
-/// mode on `device` (the inference device of the training backend).
+/// mode on `device` (the inference device of the training backend), the spatial rows of
+/// `val`'s points selected from `table` (on `device`) where there is one.
 pub fn validation_loss(
     model: &BrdfModel,
     config: &RunConfig,
     val: &TrainingData,
+    table: Option<&SpatialTable>,
     device: &Device,
 ) -> Result<f64> {
-    let pred = crate::eval::predict(&model.valid(), &config.model, val, device, false)?;
+    let model = model.valid();
+    let pred = crate::eval::predict_on(&model, &config.model, val, table, device, false)?;
     Ok(gamma_mse(val, &pred.f))
 }
 

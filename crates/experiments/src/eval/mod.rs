@@ -26,7 +26,7 @@ pub mod predict;
 pub mod probe;
 
 pub use fitted::FittedRun;
-pub use predict::{ModelBrdf, Prediction, predict};
+pub use predict::{ModelBrdf, Prediction, predict, predict_on};
 
 use crate::Result;
 use crate::data::TrainingData;
@@ -113,9 +113,12 @@ fn snapshot_curve(
     (samples, data): (&SampleSet, &TrainingData),
 ) -> Result<Vec<CurvePoint>> {
     let mut out = Vec::with_capacity(snapshots.len());
+    let gpu = !brdf_neural::device::is_cpu_device(&fitted.device);
+    let table = crate::trainer::device_table(&fitted.config.model, data, gpu, &fitted.device)?;
     for s in snapshots {
         let model = fitted.load_weights_file(&RunDir::new(run).snapshot(s.step))?;
-        let pred = predict(&model, &fitted.config.model, data, &fitted.device, false)?;
+        let config = &fitted.config.model;
+        let pred = predict_on(&model, config, data, table.as_ref(), &fitted.device, false)?;
         let psnr = images::mean_psnr(&fitted.dataset, samples, data, &pred.f)?;
         let (rmse_cbrt, _) = cube_root_rmse(samples, data, &pred.f)?;
         out.push(CurvePoint { step: s.step, seconds: s.seconds, psnr, rmse_cbrt });

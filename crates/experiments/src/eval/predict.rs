@@ -72,6 +72,7 @@ pub fn forward_rows(
 /// [`forward_rows`] with each sample's spatial row selected on the device: row `points[i]`
 /// of `table` for sample i (the same values as [`forward_rows`] with those rows gathered on
 /// the CPU, without copying a row per sample and uploading it).
+#[allow(clippy::too_many_arguments)]
 pub fn forward_points(
     model: &BrdfModel,
     config: &ModelConfig,
@@ -80,12 +81,13 @@ pub fn forward_points(
     l: &[[f32; 3]],
     v: &[[f32; 3]],
     device: &Device,
+    parts: bool,
 ) -> Result<Prediction> {
     let gpu = !brdf_neural::device::is_cpu_device(device);
     let rows = pass_rows(l.len(), gpu);
     let _split = gpu.then(|| split_k::scope(split_k::gpu_parts(rows)));
     let samples = Samples { spatial: &[], l, v };
-    forward_padded(model, config, Spatial::Table(table, points), &samples, device, false, rows)
+    forward_padded(model, config, Spatial::Table(table, points), &samples, device, parts, rows)
 }
 
 /// Where a pass's spatial rows come from.
@@ -152,7 +154,9 @@ fn forward_padded(
     Ok(p)
 }
 
-/// Evaluates `model` on every record of `data` (with the additive parts when `parts`).
+/// Evaluates `model` on every record of `data` (with the additive parts when `parts`); on a
+/// GPU the records' spatial rows are selected on the device ([`predict_on`] with a table of
+/// `data`'s points, [`crate::trainer::device_table`]).
 pub fn predict(
     model: &BrdfModel,
     config: &ModelConfig,
@@ -160,15 +164,35 @@ pub fn predict(
     device: &Device,
     parts: bool,
 ) -> Result<Prediction> {
+    let gpu = !brdf_neural::device::is_cpu_device(device);
+    let table = crate::trainer::device_table(config, data, gpu, device)?;
+    predict_on(model, config, data, table.as_ref(), device, parts)
+}
+
+/// [`predict`] with the spatial rows of `data`'s points on the device already (`table`, on
+/// `device`), or gathered on the CPU chunk by chunk (`None`).
+pub fn predict_on(
+    model: &BrdfModel,
+    config: &ModelConfig,
+    data: &TrainingData,
+    table: Option<&SpatialTable>,
+    device: &Device,
+    parts: bool,
+) -> Result<Prediction> {
     let mut all = Prediction::default();
     for start in (0..data.len()).step_by(CHUNK) {
         let end = (start + CHUNK).min(data.len());
-        let samples = Samples {
-            spatial: &data.spatial_rows(start..end),
-            l: &data.l[start..end],
-            v: &data.v[start..end],
+        let (l, v) = (&data.l[start..end], &data.v[start..end]);
+        let p = match table {
+            Some(table) => {
+                let points = &data.point[start..end];
+                forward_points(model, config, table, points, l, v, device, parts)?
+            }
+            None => {
+                let samples = Samples { spatial: &data.spatial_rows(start..end), l, v };
+                forward_rows(model, config, &samples, device, parts)?
+            }
         };
-        let p = forward_rows(model, config, &samples, device, parts)?;
         all.f.extend(p.f);
         for (dst, src) in [
             (&mut all.diffuse, p.diffuse),
@@ -236,7 +260,7 @@ impl metrics::BatchBrdf for ModelBrdf<'_> {
         let p = match &self.table {
             Some(table) => {
                 let rows: Vec<u32> = points.iter().map(|&p| self.data.point[p as usize]).collect();
-                forward_points(self.model, self.config, table, &rows, l, v, self.device)
+                forward_points(self.model, self.config, table, &rows, l, v, self.device, false)
             }
             None => {
                 let k = self.data.spatial_dim;
