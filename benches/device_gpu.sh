@@ -374,7 +374,9 @@ if [ "$STAGE" = checks ]; then
     # (NEURAL_BRDF_GPU_CHECKED=1): the wgpu tests on the real GPU; one 128-wide layer's three
     # products at 2^15 rows, both ways (the `layer` bench); every kind's step back to back with
     # PyTorch eager f32 (one round), then checked; the default run's Single MLP and FMBRDF (its
-    # Lambda network dense on a GPU since 7f07314) for 1,400 steps with `nvidia-smi dmon`.
+    # Lambda network dense on a GPU since 7f07314) for 1,400 steps with `nvidia-smi dmon`; its
+    # warm-up table gives each model's start-up in a process after the first (fit called to
+    # first step done, the persistent GPU cache filled by the earlier processes).
     # One call: DEVICE_DEADLINE=400 bash benches/device_gpu.sh checks
     export PYTHONPATH=$PWD/crates/py-neural-brdfs/python${PYTHONPATH:+:$PYTHONPATH}
     export NEURAL_BRDF_GPU_CACHE=/tmp/gpu-cache NEURAL_BRDF_GPU_LINEAR=ours

@@ -212,6 +212,7 @@ pub fn fit_and_keep(
     run: &Path,
     options: FitOptions,
 ) -> Result<(FitOutcome, Option<Trained>)> {
+    let started = std::time::Instant::now();
     config.validate()?;
     // One process at a time in a run directory; taking the lock removes the temporaries of a
     // process killed in it.
@@ -265,6 +266,8 @@ pub fn fit_and_keep(
         records,
         bar,
         loss_reads,
+        started,
+        startup_seconds: Default::default(),
     };
     // The matrix-product precision of this thread's training steps; evaluation keeps f32.
     let precision = t.matmul_precision.scope(options.backend)?;
@@ -324,6 +327,7 @@ pub fn fit_and_keep(
     crate::export::portable::write(&dir, &dir.weights(), config, &scene, &cache)?;
     let mut metrics = run_metrics(config, &state, &data, val.len());
     metrics.backend = Some(options.backend);
+    metrics.startup_seconds = lp.startup_seconds.get();
     metrics.val_loss_floor = val_floor;
     metrics.write(&dir.metrics())?;
     let device = lp.device.inner();
@@ -392,5 +396,6 @@ fn run_metrics(
         test: None,
         phases: Some(state.phases.clone()),
         backend: None,
+        startup_seconds: None,
     }
 }

@@ -64,6 +64,11 @@ pub(crate) struct Loop<'a> {
     /// Steps between host reads of the training loss ([`crate::loss_window`]): 1 on the CPU,
     /// [`GPU_LOSS_READS`] on a GPU.
     pub loss_reads: u64,
+    /// When this process's fit began.
+    pub started: Instant,
+    /// Seconds from [`Loop::started`] to the end of this process's first step (its kernels
+    /// launched, its loss read), once it has run.
+    pub startup_seconds: std::cell::Cell<Option<f64>>,
 }
 
 /// Steps between host reads of the loss on a GPU (`FitOptions::loss_reads`' default there).
@@ -121,9 +126,14 @@ impl Loop<'_> {
             let lr = t.lr_at(step) * state.plateau.lr_scale;
             timer.charge(Phase::Bookkeeping);
             let loss;
-            let read_now = self.loss_reads == 1;
+            // The process's first step is read at once: its end is the start-up's.
+            let first = self.startup_seconds.get().is_none();
+            let read_now = self.loss_reads == 1 || first;
             (model, loss) =
                 self.step(model, optim, (step, lr), &last_checkpoint, &mut timer, read_now)?;
+            if first {
+                self.startup_seconds.set(Some(self.started.elapsed().as_secs_f64()));
+            }
             state.step += 1;
             losses.push(state.step, lr, seconds_before + start.elapsed().as_secs_f64(), loss);
             self.bar.set_position(state.step);

@@ -108,6 +108,9 @@ fn models_fit_the_scene_and_eval_scores_them() {
         let out = fit(&config(kind, 300, eval), &run, FitOptions::default()).unwrap();
         let FitOutcome::Finished { metrics, resumed_from: 0 } = out else { panic!("{out:?}") };
         assert_eq!(metrics.steps, 300);
+        // The start-up (scene, caches, device, the first step) is part of the wall time.
+        let startup = metrics.startup_seconds.expect("the start-up is recorded");
+        assert!(startup > 0.0 && startup < metrics.wall_seconds + 60.0, "{kind}: {startup}");
         let l = loss_values(&run);
         let (first, zero) = (l[0], metrics.zero_prediction_loss);
         let last = l[l.len() - 3..].iter().sum::<f32>() / 3.0;

@@ -276,6 +276,13 @@ pub struct RunMetrics {
     /// The burn backend that trained the run (absent in runs trained before it was recorded).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub backend: Option<brdf_neural::device::Backend>,
+    /// Seconds from the start of the last process's fit to the end of its first step (every
+    /// kernel of the step launched, its loss read): reading the scene and its caches, making
+    /// the device and its tables, and on a GPU compiling (or loading from the persistent
+    /// cache) the step's kernels.
+    /// Absent in runs trained before it was recorded, and where the process trained no step.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub startup_seconds: Option<f64>,
 }
 
 impl RunMetrics {

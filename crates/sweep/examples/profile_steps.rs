@@ -29,7 +29,9 @@
 //! On a GPU backend each model first trains `PROFILE_WARMUP_STEPS` steps (default 50; 0 on the
 //! CPU) in a run of its own, timed apart: burn's autotune benchmarks kernels at the first use of
 //! each problem shape in a process, and that start-up would otherwise be spread over the
-//! measured steps. The warm-up table gives what it cost.
+//! measured steps. The warm-up table gives what it cost, and its start-up: from the call of
+//! the fit to the end of its first step (`RunMetrics::startup_seconds`), the figure of a fit
+//! started in a fresh process once an earlier one has filled the persistent GPU cache.
 
 use experiments::eval::eval_fitted;
 use experiments::train::{FitOptions, fit_and_keep};
@@ -118,8 +120,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let mut short = config.clone();
             short.train.iterations = warmup;
             let start = Instant::now();
-            fit_and_keep(&short, &tmp.join(format!("{kind}-warmup")), options())?;
-            warmups.push((kind.clone(), start.elapsed().as_secs_f64()));
+            let (warm, _) = fit_and_keep(&short, &tmp.join(format!("{kind}-warmup")), options())?;
+            let startup = match warm {
+                experiments::train::FitOutcome::Finished { metrics, .. } => metrics.startup_seconds,
+                _ => None,
+            };
+            warmups.push((kind.clone(), start.elapsed().as_secs_f64(), startup));
         }
         let (outcome, trained) = fit_and_keep(&config, &run, options())?;
         let trained = trained.ok_or_else(|| format!("{kind}: did not train ({outcome:?})"))?;
@@ -162,10 +168,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         println!("| {kind} | {} | {:.2} |", cells.join(" | "), test.seconds);
     }
     if !warmups.is_empty() {
-        println!("\n| model | warm-up: {warmup} steps, wall s (kernel tuning and compilation) |");
-        println!("| --- | ---: |");
-        for (kind, secs) in &warmups {
-            println!("| {kind} | {secs:.2} |");
+        println!(
+            "\n| model | warm-up: {warmup} steps, wall s (kernel tuning and compilation) | \
+             its start-up: fit called to first step done, s |"
+        );
+        println!("| --- | ---: | ---: |");
+        for (kind, secs, startup) in &warmups {
+            let startup = startup.map_or("-".into(), |s| format!("{s:.2}"));
+            println!("| {kind} | {secs:.2} | {startup} |");
         }
     }
     std::fs::remove_dir_all(&tmp).ok();
