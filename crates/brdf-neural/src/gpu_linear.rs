@@ -18,7 +18,7 @@
 //! | variable | values | default |
 //! | --- | --- | --- |
 //! | `NEURAL_BRDF_GPU_SPLIT_LEN` | batch rows each split of a weight gradient sums: a power of two from 64 to 65,536 | `gpu_kernels::linear::splits`' rule (enough splits for 256 cubes) |
-//! | `NEURAL_BRDF_GPU_TILE` | the products' tile: `64` or `128` | `64` |
+//! | `NEURAL_BRDF_GPU_TILE` | the products' tile: `64`, `128`, or `64v` (64 wide, read from shared memory four floats at a time) | `64` |
 //! | `NEURAL_BRDF_GPU_CHECKED` | `1`: launch with CubeCL's index checks and wgpu's loop counters (`gpu_kernels::checks`), `0`: without | `0` |
 
 use std::sync::OnceLock;
@@ -83,13 +83,26 @@ pub fn parse_split_len(value: &str) -> crate::Result<u32> {
 /// The environment variable that sets the tile of `ours`' products.
 pub const TILE_VAR: &str = "NEURAL_BRDF_GPU_TILE";
 
-/// Parses a tile width: 64 or 128.
-pub fn parse_tile(value: &str) -> crate::Result<u32> {
+/// The products' tiles of `ours` ([`TILE_VAR`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GpuTile {
+    /// `64`: 64 x 64, 4 x 4 sums a unit (the default).
+    T64,
+    /// `128`: 128 x 128, 8 x 8 sums a unit.
+    T128,
+    /// `64v`: 64 x 64, the slabs read from shared memory four floats at a time.
+    T64V,
+}
+
+/// Parses a tile: `64`, `128` or `64v`.
+pub fn parse_tile(value: &str) -> crate::Result<GpuTile> {
     match value.trim() {
-        "64" => Ok(64),
-        "128" => Ok(128),
+        "64" => Ok(GpuTile::T64),
+        "128" => Ok(GpuTile::T128),
+        "64v" | "64V" => Ok(GpuTile::T64V),
         _ => Err(crate::Error::Setting(format!(
-            "{TILE_VAR}={value:?}: expected 64 or 128 (the width of the products' tiles)"
+            "{TILE_VAR}={value:?}: expected 64, 128 or 64v (the products' tiles; 64v reads \
+             them from shared memory four floats at a time)"
         ))),
     }
 }
@@ -121,8 +134,9 @@ pub(crate) fn configure() -> crate::Result<()> {
     }
     if let Ok(value) = std::env::var(TILE_VAR) {
         let tiling = match parse_tile(&value)? {
-            128 => gpu_kernels::gemm::Tiling::T128,
-            _ => gpu_kernels::gemm::Tiling::T64,
+            GpuTile::T64 => gpu_kernels::gemm::Tiling::T64,
+            GpuTile::T128 => gpu_kernels::gemm::Tiling::T128,
+            GpuTile::T64V => gpu_kernels::gemm::Tiling::T64V,
         };
         gpu_kernels::linear::set_tiling(tiling);
     }
@@ -158,11 +172,12 @@ mod tests {
 
     #[test]
     fn tiles_parse_and_bad_ones_name_the_variable() {
-        assert_eq!(parse_tile("64").unwrap(), 64);
-        assert_eq!(parse_tile(" 128").unwrap(), 128);
-        for bad in ["32", "256", "wide", ""] {
+        assert_eq!(parse_tile("64").unwrap(), GpuTile::T64);
+        assert_eq!(parse_tile(" 128").unwrap(), GpuTile::T128);
+        assert_eq!(parse_tile("64v").unwrap(), GpuTile::T64V);
+        for bad in ["32", "256", "wide", "", "128v"] {
             let e = parse_tile(bad).unwrap_err().to_string();
-            assert!(e.contains(TILE_VAR) && e.contains("128"), "{e}");
+            assert!(e.contains(TILE_VAR) && e.contains("128") && e.contains("64v"), "{e}");
         }
     }
 

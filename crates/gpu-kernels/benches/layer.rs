@@ -1,17 +1,19 @@
 //! One 128-wide hidden layer of a training step on the first wgpu device: the forward product
-//! (bias and ReLU fused), the input gradient and the weight gradient (split-K), each launched
-//! unchecked (the default) and checked (CubeCL's index checks and wgpu's loop counters, see
-//! `gpu_kernels::checks`), back to back in the same run. Every timed call ends by waiting for
-//! the device.
+//! (bias and ReLU fused), the input gradient and the weight gradient (split-K), on each
+//! variant back to back in the same run: the default (64-wide tiles, launched unchecked), the
+//! same launched checked (CubeCL's index checks and wgpu's loop counters, see
+//! `gpu_kernels::checks`), 128-wide tiles, and 64-wide tiles read from shared memory four
+//! floats at a time. Every timed call ends by waiting for the device.
 //!
 //! `cargo bench -p gpu-kernels --features wgpu --bench layer`. Environment:
 //! `GPU_KERNELS_BENCH_ROWS` (default 8192: Mesa's lavapipe runs on the CPU; 32768 is the
-//! training step's batch on a GPU). A summary line per operation gives GFLOP/s (2 m n k) and
-//! the checked/unchecked time ratio.
+//! training step's batch on a GPU). A summary line per operation and variant gives GFLOP/s
+//! (2 m n k) and the time as a ratio of the default's.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use cubecl::prelude::*;
 use gpu_kernels::checks;
+use gpu_kernels::gemm::Tiling;
 use gpu_kernels::linear::{self, Matrix};
 use std::time::Instant;
 
@@ -48,15 +50,21 @@ fn layer(c: &mut Criterion) {
     let flop = 2.0 * rows as f64 * WIDTH as f64 * WIDTH as f64;
     let mut group = c.benchmark_group(format!("layer_{rows}x{WIDTH}x{WIDTH}"));
     group.sample_size(10);
+    let variants = [
+        ("64", Tiling::T64, false),
+        ("64 checked", Tiling::T64, true),
+        ("128", Tiling::T128, false),
+        ("64v", Tiling::T64V, false),
+    ];
     let mut summary = Vec::new();
     for (name, op) in OPS {
-        let mut seconds = [0.0f64; 2];
-        for (mode, checked) in [(0, false), (1, true)] {
+        let mut default_seconds = None;
+        for (label, tiling, checked) in variants {
             checks::set_checked(checked);
+            linear::set_tiling(tiling);
             // Compiles the kernel outside the timing.
             op(&client, &x, &w, &dy, &b.handle);
             wait(&client);
-            let label = if checked { "checked" } else { "unchecked" };
             group.bench_function(BenchmarkId::new(name, label), |bench| {
                 bench.iter(|| {
                     op(&client, &x, &w, &dy, &b.handle);
@@ -69,19 +77,18 @@ fn layer(c: &mut Criterion) {
                 op(&client, &x, &w, &dy, &b.handle);
             }
             wait(&client);
-            seconds[mode] = t.elapsed().as_secs_f64() / reps as f64;
+            let seconds = t.elapsed().as_secs_f64() / reps as f64;
+            let base = *default_seconds.get_or_insert(seconds);
+            summary.push(format!(
+                "{name}, {label}: {:.3} ms, {:.1} GFLOP/s, {:.2} x the default's time",
+                1e3 * seconds,
+                flop / seconds / 1e9,
+                seconds / base,
+            ));
         }
-        summary.push(format!(
-            "{name}: unchecked {:.2} ms ({:.1} GFLOP/s), checked {:.2} ms ({:.1} GFLOP/s), \
-             checked/unchecked {:.2}",
-            1e3 * seconds[0],
-            flop / seconds[0] / 1e9,
-            1e3 * seconds[1],
-            flop / seconds[1] / 1e9,
-            seconds[1] / seconds[0],
-        ));
     }
     checks::set_checked(false);
+    linear::set_tiling(Tiling::T64);
     group.finish();
     for line in summary {
         eprintln!("{line}");

@@ -20,6 +20,7 @@
 //! | `bias` | n | added to every row (epilogue [`Epilogue::Bias`] or [`Epilogue::BiasRelu`]) |
 //! | `c` | splits x m x n, row-major | the product, or one partial sum per split |
 
+use crate::gemm_vec4::gemm_vec4;
 use cubecl::prelude::*;
 
 /// Units per cube along each axis.
@@ -32,9 +33,15 @@ pub enum Tiling {
     T64,
     /// 128 x 128, 8 x 8 sums a unit: twice the arithmetic per shared-memory read.
     T128,
+    /// 64 x 64, 4 x 4 sums a unit in contiguous rows and columns, the slabs read from shared
+    /// memory four floats at a time ([`crate::gemm_vec4`]).
+    T64V,
 }
 
 impl Tiling {
+    /// Every tiling (the tests run each).
+    pub const ALL: [Tiling; 3] = [Tiling::T64, Tiling::T128, Tiling::T64V];
+
     /// Rows and columns of C per cube.
     pub fn tile(self) -> u32 {
         UNITS * self.per_unit()
@@ -43,7 +50,7 @@ impl Tiling {
     /// Rows and columns of sums per unit.
     pub fn per_unit(self) -> u32 {
         match self {
-            Tiling::T64 => 4,
+            Tiling::T64 | Tiling::T64V => 4,
             Tiling::T128 => 8,
         }
     }
@@ -234,6 +241,32 @@ pub unsafe fn launch_gemm(
     let tile = shape.tiling.tile();
     let grid = CubeCount::Static(shape.n.div_ceil(tile), shape.m.div_ceil(tile), splits);
     let [la, lb, lbias, lc] = lens;
+    if shape.tiling == Tiling::T64V {
+        unsafe {
+            crate::checks::launch!(
+                gemm_vec4,
+                client,
+                grid,
+                CubeDim::new_2d(UNITS, UNITS),
+                BufferArg::from_raw_parts(a, la),
+                BufferArg::from_raw_parts(b, lb),
+                BufferArg::from_raw_parts(bias, lbias),
+                BufferArg::from_raw_parts(c, lc),
+                shape.m,
+                shape.n,
+                shape.k,
+                shape.a_strides.0,
+                shape.a_strides.1,
+                shape.b_strides.0,
+                shape.b_strides.1,
+                per_split,
+                epilogue.code(),
+                shape.a_strides.1 == 1,
+                shape.b_strides.1 == 1,
+            );
+        }
+        return;
+    }
     unsafe {
         crate::checks::launch!(
             gemm_tiled,

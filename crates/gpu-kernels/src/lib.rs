@@ -5,6 +5,7 @@
 //! | module | what |
 //! | --- | --- |
 //! | [`gemm`] | the tiled f32 product with strided operands, the bias and ReLU fused, split-K |
+//! | [`gemm_vec4`] | the same product with 4-wide shared-memory reads ([`gemm::Tiling::T64V`]) |
 //! | [`reduce`] | fixed-order sums: split-K's partials, column sums (the bias gradient) |
 //! | [`elementwise`] | the ReLU backward |
 //! | [`linear`] | a layer's five operations on row-major [`linear::Matrix`]es, shapes checked |
@@ -18,5 +19,6 @@
 pub mod checks;
 pub mod elementwise;
 pub mod gemm;
+pub mod gemm_vec4;
 pub mod linear;
 pub mod reduce;

@@ -1,5 +1,5 @@
 //! Each operation of `gpu_kernels::linear` against an f64 reference on the wgpu runtime (any
-//! Vulkan device; Mesa's lavapipe will do), on both tiles (64 and 128 wide): shapes that fill
+//! Vulkan device; Mesa's lavapipe will do), on every tiling (64 and 128 wide, and 64 wide with 4-wide shared reads): shapes that fill
 //! the tiles and shapes that do not, one split and many, NaN and negative inputs through the ReLU, the same bits on a
 //! second run, the same bits from checked launches, and shape errors that name the operation.
 //!
@@ -71,7 +71,7 @@ const SHAPES: [(u32, u32, u32); 5] =
 
 #[test]
 fn forward_matches_the_reference_with_and_without_bias_and_relu() {
-    for tiling in [Tiling::T64, Tiling::T128] {
+    for tiling in Tiling::ALL {
         let _scope = TilingScope::new(tiling);
         forward_matches_on(tiling);
     }
@@ -109,7 +109,7 @@ fn forward_matches_on(tiling: Tiling) {
 
 #[test]
 fn gradients_match_the_reference() {
-    for tiling in [Tiling::T64, Tiling::T128] {
+    for tiling in Tiling::ALL {
         let _scope = TilingScope::new(tiling);
         gradients_match_on(tiling);
     }
@@ -183,7 +183,7 @@ fn checked_launches_give_the_same_bits_as_unchecked_ones() {
     // nothing. The setting is process-wide: another test running meanwhile may run checked,
     // which by this very property changes none of its results.
     let client = client();
-    for tiling in [Tiling::T64, Tiling::T128] {
+    for tiling in Tiling::ALL {
         assert!(!checks::checked(), "unchecked is the default");
         let unchecked = all_outputs(&client, tiling);
         checks::set_checked(true);
