@@ -24,7 +24,7 @@
 #   bash benches/device_gpu.sh tiles     # after `linear`: gpu-kernels' split rule and both
 #                                        # tiles, every kind beside PyTorch, the loop
 #   bash benches/device_gpu.sh checks    # gpu-kernels unchecked (the default), checked, and
-#                                        # with 4-wide shared reads (64v): one layer's
+#                                        # with 4-wide shared reads (64v, 128v): one layer's
 #                                        # products, every kind beside PyTorch, the loop with
 #                                        # FMBRDF's dense Lambda network, the start-up
 #
@@ -371,33 +371,37 @@ if [ "$STAGE" = tiles ]; then
 fi
 if [ "$STAGE" = checks ]; then
     # gpu-kernels launched without CubeCL's index checks and wgpu's loop counters (the default
-    # since the H200's products ran at 7 to 8 % of its FP32 rate), and the 64-wide tiles read
-    # from shared memory four floats at a time (NEURAL_BRDF_GPU_TILE=64v): the wgpu tests on
-    # the real GPU with both tilings; one 128-wide layer's three products at 2^15 rows on every
-    # variant (the `layer` bench: 64, 64 checked, 128, 64v); every kind's step back to back
-    # with PyTorch eager f32 (one round), then on 64v; the default run's Single MLP and FMBRDF
+    # since the H200's products ran at 7 to 8 % of its FP32 rate), and the tiles read from
+    # shared memory four floats at a time (NEURAL_BRDF_GPU_TILE=64v, 128v): the wgpu tests on
+    # the real GPU with those tilings; one 128-wide layer's three products at 2^15 rows on every
+    # variant (the `layer` bench: 64, 64 checked, 128, 64v, 128v); every kind's step back to
+    # back with PyTorch eager f32 (one round), then on 64v and 128v; the default run's Single
+    # MLP and FMBRDF
     # (its Lambda network dense on a GPU since 7f07314) for 1,400 steps with `nvidia-smi dmon`;
     # its warm-up table gives each model's start-up in a process after the first (fit called
     # to first step done, the persistent GPU cache filled by the earlier processes).
-    # One call: DEVICE_DEADLINE=450 bash benches/device_gpu.sh checks
+    # One call: DEVICE_DEADLINE=500 bash benches/device_gpu.sh checks
     export PYTHONPATH=$PWD/crates/py-neural-brdfs/python${PYTHONPATH:+:$PYTHONPATH}
     export NEURAL_BRDF_GPU_CACHE=/tmp/gpu-cache NEURAL_BRDF_GPU_LINEAR=ours
     python3 -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name(0))"
-    for tile in 64 64v; do
+    for tile in 64 64v 128v; do
         step "wgpu against the CPU on this GPU, gpu-kernels unchecked, tiles $tile"
-        run 40 "gpu_backend_$tile.log" env NEURAL_BRDF_GPU_TILE=$tile \
+        run 30 "gpu_backend_$tile.log" env NEURAL_BRDF_GPU_TILE=$tile \
             CUBECL_AUTOTUNE_LEVEL=minimal $B/gpu_backend --test-threads=1
     done
-    step "one layer's products at 2^15 rows: 64, 64 checked, 128, 64v"
+    step "one layer's products at 2^15 rows: 64, 64 checked, 128, 64v, 128v"
     run 60 layer.log env GPU_KERNELS_BENCH_ROWS=32768 $B/layer --bench --warm-up-time 1 \
         --measurement-time 1
     step "the wgpu step, all 9 kinds, against PyTorch eager f32"
     run 130 step_ours.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_ALL_MODELS=1 \
         BRDF_BENCH_BACKENDS=wgpu BRDF_BENCH_RATES=1 BRDF_BENCH_PYTORCH=python3 \
         BRDF_BENCH_PYTORCH_ROUNDS=1 $B/train_step --bench
-    step "the wgpu step, all 9 kinds, tiles 64v"
-    run 60 step_ours_64v.log env NEURAL_BRDF_GPU_TILE=64v BRDF_BENCH_QUICK=1 \
-        BRDF_BENCH_ALL_MODELS=1 BRDF_BENCH_BACKENDS=wgpu BRDF_BENCH_RATES=1 $B/train_step --bench
+    for tile in 64v 128v; do
+        step "the wgpu step, all 9 kinds, tiles $tile"
+        run 50 "step_ours_$tile.log" env NEURAL_BRDF_GPU_TILE=$tile BRDF_BENCH_QUICK=1 \
+            BRDF_BENCH_ALL_MODELS=1 BRDF_BENCH_BACKENDS=wgpu BRDF_BENCH_RATES=1 \
+            $B/train_step --bench
+    done
     export PROFILE_WARMUP_STEPS=50 PROFILE_EVAL=none
     run 30 default_scenes.log $B/profile_steps --prepare default /tmp/default
     nvidia-smi dmon -s u -d 1 -o T >"$LOGS/gpu_use.log" 2>&1 &

@@ -18,7 +18,7 @@
 //! | variable | values | default |
 //! | --- | --- | --- |
 //! | `NEURAL_BRDF_GPU_SPLIT_LEN` | batch rows each split of a weight gradient sums: a power of two from 64 to 65,536 | `gpu_kernels::linear::splits`' rule (enough splits for 256 cubes) |
-//! | `NEURAL_BRDF_GPU_TILE` | the products' tile: `64`, `128`, or `64v` (64 wide, read from shared memory four floats at a time) | `64` |
+//! | `NEURAL_BRDF_GPU_TILE` | the products' tile: `64`, `128`, `64v` or `128v` (read from shared memory four floats at a time) | `64` |
 //! | `NEURAL_BRDF_GPU_CHECKED` | `1`: launch with CubeCL's index checks and wgpu's loop counters (`gpu_kernels::checks`), `0`: without | `0` |
 
 use std::sync::OnceLock;
@@ -92,17 +92,20 @@ pub enum GpuTile {
     T128,
     /// `64v`: 64 x 64, the slabs read from shared memory four floats at a time.
     T64V,
+    /// `128v`: 128 x 128, 8 x 8 sums a unit, read from shared memory four floats at a time.
+    T128V,
 }
 
-/// Parses a tile: `64`, `128` or `64v`.
+/// Parses a tile: `64`, `128`, `64v` or `128v`.
 pub fn parse_tile(value: &str) -> crate::Result<GpuTile> {
     match value.trim() {
         "64" => Ok(GpuTile::T64),
         "128" => Ok(GpuTile::T128),
         "64v" | "64V" => Ok(GpuTile::T64V),
+        "128v" | "128V" => Ok(GpuTile::T128V),
         _ => Err(crate::Error::Setting(format!(
-            "{TILE_VAR}={value:?}: expected 64, 128 or 64v (the products' tiles; 64v reads \
-             them from shared memory four floats at a time)"
+            "{TILE_VAR}={value:?}: expected 64, 128, 64v or 128v (the products' tiles; the \
+             v ones are read from shared memory four floats at a time)"
         ))),
     }
 }
@@ -137,6 +140,7 @@ pub(crate) fn configure() -> crate::Result<()> {
             GpuTile::T64 => gpu_kernels::gemm::Tiling::T64,
             GpuTile::T128 => gpu_kernels::gemm::Tiling::T128,
             GpuTile::T64V => gpu_kernels::gemm::Tiling::T64V,
+            GpuTile::T128V => gpu_kernels::gemm::Tiling::T128V,
         };
         gpu_kernels::linear::set_tiling(tiling);
     }
@@ -175,7 +179,8 @@ mod tests {
         assert_eq!(parse_tile("64").unwrap(), GpuTile::T64);
         assert_eq!(parse_tile(" 128").unwrap(), GpuTile::T128);
         assert_eq!(parse_tile("64v").unwrap(), GpuTile::T64V);
-        for bad in ["32", "256", "wide", "", "128v"] {
+        assert_eq!(parse_tile("128v").unwrap(), GpuTile::T128V);
+        for bad in ["32", "256", "wide", "", "256v"] {
             let e = parse_tile(bad).unwrap_err().to_string();
             assert!(e.contains(TILE_VAR) && e.contains("128") && e.contains("64v"), "{e}");
         }

@@ -2,8 +2,8 @@
 //! (bias and ReLU fused), the input gradient and the weight gradient (split-K), on each
 //! variant back to back in the same run: the default (64-wide tiles, launched unchecked), the
 //! same launched checked (CubeCL's index checks and wgpu's loop counters, see
-//! `gpu_kernels::checks`), 128-wide tiles, and 64-wide tiles read from shared memory four
-//! floats at a time. Every timed call ends by waiting for the device.
+//! `gpu_kernels::checks`), 128-wide tiles, and 64- and 128-wide tiles read from shared
+//! memory four floats at a time. Every timed call ends by waiting for the device.
 //!
 //! `cargo bench -p gpu-kernels --features wgpu --bench layer`. Environment:
 //! `GPU_KERNELS_BENCH_ROWS` (default 8192: Mesa's lavapipe runs on the CPU; 32768 is the
@@ -55,6 +55,7 @@ fn layer(c: &mut Criterion) {
         ("64 checked", Tiling::T64, true),
         ("128", Tiling::T128, false),
         ("64v", Tiling::T64V, false),
+        ("128v", Tiling::T128V, false),
     ];
     let mut summary = Vec::new();
     for (name, op) in OPS {

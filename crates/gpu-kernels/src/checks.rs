@@ -3,8 +3,9 @@
 //! counter. The kernels guard their own reads and writes (the products zero-pad past the
 //! matrices' edges), so by default they launch unchecked: the extra compare on each load and
 //! the loop counters cost the inner loop of a product, and the counters keep the driver from
-//! unrolling it. Checked launches remain a process-wide setting, a debugging aid that gives
-//! the same results, and a knob for the benchmarks to measure what the checks cost.
+//! unrolling it. burn's own GPU products (cubek-matmul) launch unchecked for the same reason.
+//! Checked launches remain a process-wide setting, a debugging aid that gives the same
+//! results, and a knob for the benchmarks to measure what the checks cost.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 

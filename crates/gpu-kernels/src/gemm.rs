@@ -20,7 +20,7 @@
 //! | `bias` | n | added to every row (epilogue [`Epilogue::Bias`] or [`Epilogue::BiasRelu`]) |
 //! | `c` | splits x m x n, row-major | the product, or one partial sum per split |
 
-use crate::gemm_vec4::gemm_vec4;
+use crate::gemm_vec4::{gemm_vec4, gemm_vec4_128};
 use cubecl::prelude::*;
 
 /// Units per cube along each axis.
@@ -36,11 +36,14 @@ pub enum Tiling {
     /// 64 x 64, 4 x 4 sums a unit in contiguous rows and columns, the slabs read from shared
     /// memory four floats at a time ([`crate::gemm_vec4`]).
     T64V,
+    /// 128 x 128, 8 x 8 sums a unit in two blocks of four contiguous rows and columns, the
+    /// slabs read from shared memory four floats at a time ([`crate::gemm_vec4`]).
+    T128V,
 }
 
 impl Tiling {
     /// Every tiling (the tests run each).
-    pub const ALL: [Tiling; 3] = [Tiling::T64, Tiling::T128, Tiling::T64V];
+    pub const ALL: [Tiling; 4] = [Tiling::T64, Tiling::T128, Tiling::T64V, Tiling::T128V];
 
     /// Rows and columns of C per cube.
     pub fn tile(self) -> u32 {
@@ -51,7 +54,7 @@ impl Tiling {
     pub fn per_unit(self) -> u32 {
         match self {
             Tiling::T64 | Tiling::T64V => 4,
-            Tiling::T128 => 8,
+            Tiling::T128 | Tiling::T128V => 8,
         }
     }
 }
@@ -241,6 +244,32 @@ pub unsafe fn launch_gemm(
     let tile = shape.tiling.tile();
     let grid = CubeCount::Static(shape.n.div_ceil(tile), shape.m.div_ceil(tile), splits);
     let [la, lb, lbias, lc] = lens;
+    if shape.tiling == Tiling::T128V {
+        unsafe {
+            crate::checks::launch!(
+                gemm_vec4_128,
+                client,
+                grid,
+                CubeDim::new_2d(UNITS, UNITS),
+                BufferArg::from_raw_parts(a, la),
+                BufferArg::from_raw_parts(b, lb),
+                BufferArg::from_raw_parts(bias, lbias),
+                BufferArg::from_raw_parts(c, lc),
+                shape.m,
+                shape.n,
+                shape.k,
+                shape.a_strides.0,
+                shape.a_strides.1,
+                shape.b_strides.0,
+                shape.b_strides.1,
+                per_split,
+                epilogue.code(),
+                shape.a_strides.1 == 1,
+                shape.b_strides.1 == 1,
+            );
+        }
+        return;
+    }
     if shape.tiling == Tiling::T64V {
         unsafe {
             crate::checks::launch!(

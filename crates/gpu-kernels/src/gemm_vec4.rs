@@ -1,6 +1,11 @@
 //! The tiled f32 product of [`crate::gemm`] with its shared-memory reads four floats wide
-//! ([`Tiling::T64V`]): the same arguments, zero padding, split-K and epilogues, a different
-//! register block.
+//! ([`Tiling::T64V`] and [`Tiling::T128V`]): the same arguments, zero padding, split-K and
+//! epilogues, a different register block.
+//!
+//! `gemm_vec4_128` is the 128-wide counterpart (the classic layout of fast f32 products on
+//! GPUs): unit (tx, ty) keeps 8 x 8 sums, rows `4 ty ..` and `64 + 4 ty ..`, columns `4 tx ..`
+//! and `64 + 4 tx ..` (four each), in sixteen vectors, and reads two vectors of A and two of B
+//! a k step for 64 multiply-adds. Slab rows are 32 vectors and one of padding.
 //!
 //! One cube of 16 x 16 units computes a 64 x 64 tile of C; unit (tx, ty) keeps the 4 x 4
 //! block of rows `4 ty .. 4 ty + 4` and columns `4 tx .. 4 tx + 4` in four 4-wide vectors. The
@@ -13,6 +18,7 @@
 //! whether a multiply-add is fused is the shader compiler's choice in either kernel.
 //!
 //! [`Tiling::T64V`]: crate::gemm::Tiling::T64V
+//! [`Tiling::T128V`]: crate::gemm::Tiling::T128V
 
 use cubecl::prelude::*;
 
@@ -122,6 +128,124 @@ pub(crate) fn gemm_vec4(
     store_row(c, bias, acc1, base, gi + 1, col0 + 4 * tx, m, n, epilogue);
     store_row(c, bias, acc2, base, gi + 2, col0 + 4 * tx, m, n, epilogue);
     store_row(c, bias, acc3, base, gi + 3, col0 + 4 * tx, m, n, epilogue);
+}
+
+/// Vectors per slab row of the 128-wide kernel: 32 of the tile and one of padding.
+const ROW_VECTORS_128: u32 = 33;
+
+/// Four values of `x` (rows or columns `g .. g + 4` of the transposed view `read_or_zero`
+/// takes) as a vector.
+#[cube]
+#[allow(clippy::too_many_arguments)]
+fn read4(x: &[f32], g: u32, gk: u32, len: u32, k_end: u32, rs: u32, cs: u32) -> F4 {
+    let mut v = F4::empty();
+    v.insert(0usize, read_or_zero(x, g, gk, len, k_end, rs, cs));
+    v.insert(1usize, read_or_zero(x, g + 1, gk, len, k_end, rs, cs));
+    v.insert(2usize, read_or_zero(x, g + 2, gk, len, k_end, rs, cs));
+    v.insert(3usize, read_or_zero(x, g + 3, gk, len, k_end, rs, cs));
+    v
+}
+
+/// `acc[2 r + c] += a[lane] b_c` for the four rows `r = first + lane` that the vector `av`
+/// holds, against the column vectors `b0` and `b1`.
+#[cube]
+fn outer4(acc: &mut Array<F4>, av: F4, b0: F4, b1: F4, #[comptime] first: usize) {
+    let a0 = F4::broadcast(av.extract(0usize));
+    let a1 = F4::broadcast(av.extract(1usize));
+    let a2 = F4::broadcast(av.extract(2usize));
+    let a3 = F4::broadcast(av.extract(3usize));
+    acc[2 * first] += a0 * b0;
+    acc[2 * first + 1] += a0 * b1;
+    acc[2 * first + 2] += a1 * b0;
+    acc[2 * first + 3] += a1 * b1;
+    acc[2 * first + 4] += a2 * b0;
+    acc[2 * first + 5] += a2 * b1;
+    acc[2 * first + 6] += a3 * b0;
+    acc[2 * first + 7] += a3 * b1;
+}
+
+/// The 128-wide product kernel; see the module documentation. Launched on a grid of
+/// `(ceil(n / 128), ceil(m / 128), splits)` cubes of 16 x 16 units.
+#[cube(launch, launch_unchecked)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn gemm_vec4_128(
+    a: &[f32],
+    b: &[f32],
+    bias: &[f32],
+    c: &mut [f32],
+    m: u32,
+    n: u32,
+    k: u32,
+    a_rs: u32,
+    a_cs: u32,
+    b_rs: u32,
+    b_cs: u32,
+    k_per_split: u32,
+    #[comptime] epilogue: u32,
+    #[comptime] a_rows_contiguous: bool,
+    #[comptime] b_rows_contiguous: bool,
+) {
+    let tx = UNIT_POS_X;
+    let ty = UNIT_POS_Y;
+    let lin = UNIT_POS;
+    let row0 = CUBE_POS_Y * 128;
+    let col0 = CUBE_POS_X * 128;
+    let split = CUBE_POS_Z;
+    let k_start = split * k_per_split;
+    let k_end = select(k < k_start + k_per_split, k, k_start + k_per_split);
+
+    let mut a_tile = Shared::<[F4]>::new_slice(comptime![(16 * ROW_VECTORS_128) as usize]);
+    let mut b_tile = Shared::<[F4]>::new_slice(comptime![(16 * ROW_VECTORS_128) as usize]);
+    // Row r (of 8), column half h: acc[2 r + h].
+    let mut acc = Array::<F4>::new(16usize);
+    #[unroll]
+    for e in 0..16usize {
+        acc[e] = F4::broadcast(0.0);
+    }
+
+    for k0 in range_stepped(k_start, k_end, 16u32) {
+        // Each slab holds 16 k x 32 vectors: two a unit.
+        #[unroll]
+        for t in 0..2u32 {
+            let e = lin + t * 256;
+            let mut qa = e / 16;
+            let mut ka = e % 16;
+            if comptime![!a_rows_contiguous] {
+                qa = e % 32;
+                ka = e / 32;
+            }
+            let va = read4(a, row0 + 4 * qa, k0 + ka, m, k_end, a_rs, a_cs);
+            a_tile[(ka * ROW_VECTORS_128 + qa) as usize] = va;
+            let mut qb = e % 32;
+            let mut kb = e / 32;
+            if comptime![!b_rows_contiguous] {
+                qb = e / 16;
+                kb = e % 16;
+            }
+            let vb = read4(b, col0 + 4 * qb, k0 + kb, n, k_end, b_cs, b_rs);
+            b_tile[(kb * ROW_VECTORS_128 + qb) as usize] = vb;
+        }
+        sync_cube();
+        for kk in 0..16u32 {
+            let at = kk * ROW_VECTORS_128;
+            let av0 = a_tile[(at + ty) as usize];
+            let av1 = a_tile[(at + ty + 16) as usize];
+            let b0 = b_tile[(at + tx) as usize];
+            let b1 = b_tile[(at + tx + 16) as usize];
+            outer4(&mut acc, av0, b0, b1, 0usize);
+            outer4(&mut acc, av1, b0, b1, 4usize);
+        }
+        sync_cube();
+    }
+
+    let base = split * m * n;
+    #[unroll]
+    for r in 0..8u32 {
+        let gi = row0 + 4 * ty + (r % 4) + 64 * (r / 4);
+        let at = (2 * r) as usize;
+        store_row(c, bias, acc[at], base, gi, col0 + 4 * tx, m, n, epilogue);
+        store_row(c, bias, acc[at + 1], base, gi, col0 + 64 + 4 * tx, m, n, epilogue);
+    }
 }
 
 /// Writes the four sums of `acc` to row `gi`, columns `gj .. gj + 4` of C (those inside it),

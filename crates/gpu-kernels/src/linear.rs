@@ -84,8 +84,8 @@ const MAX_CUBES: u32 = 65_535;
 
 /// 0: the default rule of [`splits`]; else a fixed split length ([`set_split_len`]).
 static SPLIT_LEN_NOW: AtomicU32 = AtomicU32::new(0);
-/// 0: [`Tiling::T64`], the default; 128: [`Tiling::T128`]; 65: [`Tiling::T64V`]
-/// ([`set_tiling`]).
+/// 0: [`Tiling::T64`], the default; 128: [`Tiling::T128`]; 65: [`Tiling::T64V`]; 129:
+/// [`Tiling::T128V`] ([`set_tiling`]).
 static TILING_NOW: AtomicU32 = AtomicU32::new(0);
 
 thread_local! {
@@ -113,6 +113,7 @@ pub fn set_tiling(tiling: Tiling) {
         Tiling::T64 => 0,
         Tiling::T128 => 128,
         Tiling::T64V => 65,
+        Tiling::T128V => 129,
     };
     TILING_NOW.store(code, Ordering::Relaxed);
 }
@@ -122,6 +123,7 @@ pub fn tiling() -> Tiling {
     TILING_HERE.with(Cell::get).unwrap_or(match TILING_NOW.load(Ordering::Relaxed) {
         128 => Tiling::T128,
         65 => Tiling::T64V,
+        129 => Tiling::T128V,
         _ => Tiling::T64,
     })
 }
