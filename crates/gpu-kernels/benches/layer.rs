@@ -1,19 +1,22 @@
-//! One 128-wide hidden layer of a training step on the first wgpu device: the forward product
-//! (bias and ReLU fused), the input gradient and the weight gradient (split-K), on each
+//! One 128-wide hidden layer of a training step on the first device of a runtime: the forward
+//! product (bias and ReLU fused), the input gradient and the weight gradient (split-K), on each
 //! variant back to back in the same run: the default (64-wide tiles, launched unchecked), the
 //! same launched checked (CubeCL's index checks and wgpu's loop counters, see
-//! `gpu_kernels::checks`), 128-wide tiles, and 64- and 128-wide tiles read from shared
-//! memory four floats at a time. Every timed call ends by waiting for the device.
+//! `gpu_kernels::checks`), 128-wide tiles, 64- and 128-wide tiles read from shared memory four
+//! floats at a time, and, where the device has bf16 tensor cores, the bf16 products. Every
+//! timed call ends by waiting for the device.
 //!
 //! `cargo bench -p gpu-kernels --features wgpu --bench layer`. Environment:
 //! `GPU_KERNELS_BENCH_ROWS` (default 8192: Mesa's lavapipe runs on the CPU; 32768 is the
-//! training step's batch on a GPU). A summary line per operation and variant gives GFLOP/s
-//! (2 m n k) and the time as a ratio of the default's.
+//! training step's batch on a GPU); `GPU_KERNELS_RUNTIME=cuda` (built with `--features
+//! wgpu,cuda`) for CubeCL's CUDA runtime instead of wgpu. A summary line per operation and
+//! variant gives GFLOP/s (2 m n k) and the time as a ratio of the default's.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use cubecl::prelude::*;
 use gpu_kernels::checks;
 use gpu_kernels::gemm::Tiling;
+use gpu_kernels::linear::Precision::{self, F32};
 use gpu_kernels::linear::{self, Matrix};
 use std::time::Instant;
 
@@ -31,17 +34,28 @@ fn wait(client: &Client) {
     cubecl::future::block_on(client.sync()).expect("the device is lost");
 }
 
-type Op = fn(&Client, &Matrix, &Matrix, &Matrix, &Handle) -> Matrix;
+type Op = fn(&Client, &Matrix, &Matrix, &Matrix, &Handle, Precision) -> Matrix;
 type Handle = cubecl::server::Handle;
 
 const OPS: [(&str, Op); 3] = [
-    ("forward", |c, x, w, _, b| linear::forward(c, x, w, Some(b), true).unwrap()),
-    ("input gradient", |c, _, w, dy, _| linear::x_backward(c, w, dy).unwrap()),
-    ("weight gradient", |c, x, _, dy, _| linear::weight_backward(c, x, dy).unwrap()),
+    ("forward", |c, x, w, _, b, p| linear::forward(c, x, w, Some(b), true, p).unwrap()),
+    ("input gradient", |c, _, w, dy, _, p| linear::x_backward(c, w, dy, p).unwrap()),
+    ("weight gradient", |c, x, _, dy, _, p| linear::weight_backward(c, x, dy, p).unwrap()),
 ];
 
+/// The runtime: `GPU_KERNELS_RUNTIME=cuda` (with the `cuda` feature), else wgpu.
+fn client() -> Client {
+    match std::env::var("GPU_KERNELS_RUNTIME").as_deref() {
+        Ok("cuda") if cfg!(feature = "cuda") => cubecl::Device::Cuda(Default::default()).client(),
+        Ok("wgpu") | Err(_) => cubecl::Device::Wgpu(Default::default()).client(),
+        Ok(other) => {
+            panic!("GPU_KERNELS_RUNTIME={other:?}: expected wgpu, or cuda when built with it")
+        }
+    }
+}
+
 fn layer(c: &mut Criterion) {
-    let client = cubecl::Device::Wgpu(Default::default()).client();
+    let client = client();
     let rows = rows();
     let x = Matrix::upload(&client, &values((rows * WIDTH) as usize, 1), rows, WIDTH).unwrap();
     let w = Matrix::upload(&client, &values((WIDTH * WIDTH) as usize, 2), WIDTH, WIDTH).unwrap();
@@ -50,32 +64,37 @@ fn layer(c: &mut Criterion) {
     let flop = 2.0 * rows as f64 * WIDTH as f64 * WIDTH as f64;
     let mut group = c.benchmark_group(format!("layer_{rows}x{WIDTH}x{WIDTH}"));
     group.sample_size(10);
-    let variants = [
-        ("64", Tiling::T64, false),
-        ("64 checked", Tiling::T64, true),
-        ("128", Tiling::T128, false),
-        ("64v", Tiling::T64V, false),
-        ("128v", Tiling::T128V, false),
+    let mut variants = vec![
+        ("64", Tiling::T64, false, F32),
+        ("64 checked", Tiling::T64, true, F32),
+        ("128", Tiling::T128, false, F32),
+        ("64v", Tiling::T64V, false, F32),
+        ("128v", Tiling::T128V, false, F32),
     ];
+    if linear::bf16_supported(&client) {
+        variants.push(("bf16", Tiling::T64, false, Precision::Bf16));
+    } else {
+        eprintln!("no bf16 tensor cores on this device: the bf16 variant is left out");
+    }
     let mut summary = Vec::new();
     for (name, op) in OPS {
         let mut default_seconds = None;
-        for (label, tiling, checked) in variants {
+        for &(label, tiling, checked, precision) in &variants {
             checks::set_checked(checked);
             linear::set_tiling(tiling);
             // Compiles the kernel outside the timing.
-            op(&client, &x, &w, &dy, &b.handle);
+            op(&client, &x, &w, &dy, &b.handle, precision);
             wait(&client);
             group.bench_function(BenchmarkId::new(name, label), |bench| {
                 bench.iter(|| {
-                    op(&client, &x, &w, &dy, &b.handle);
+                    op(&client, &x, &w, &dy, &b.handle, precision);
                     wait(&client);
                 })
             });
             let reps = 5;
             let t = Instant::now();
             for _ in 0..reps {
-                op(&client, &x, &w, &dy, &b.handle);
+                op(&client, &x, &w, &dy, &b.handle, precision);
             }
             wait(&client);
             let seconds = t.elapsed().as_secs_f64() / reps as f64;

@@ -73,7 +73,7 @@ pub enum Epilogue {
 }
 
 impl Epilogue {
-    fn code(self) -> u32 {
+    pub(crate) fn code(self) -> u32 {
         match self {
             Epilogue::None => 0,
             Epilogue::Bias => 1,

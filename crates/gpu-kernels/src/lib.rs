@@ -6,6 +6,7 @@
 //! | --- | --- |
 //! | [`gemm`] | the tiled f32 product with strided operands, the bias and ReLU fused, split-K |
 //! | [`gemm_vec4`] | the same product with 4-wide shared-memory reads ([`gemm::Tiling::T64V`]) |
+//! | [`gemm_cmma`] | the same product on tensor cores, bf16 operands, f32 sums ([`linear::Precision::Bf16`]) |
 //! | [`reduce`] | fixed-order sums: split-K's partials, column sums (the bias gradient) |
 //! | [`elementwise`] | the ReLU backward |
 //! | [`linear`] | a layer's five operations on row-major [`linear::Matrix`]es, shapes checked |
@@ -19,6 +20,7 @@
 pub mod checks;
 pub mod elementwise;
 pub mod gemm;
+pub mod gemm_cmma;
 pub mod gemm_vec4;
 pub mod linear;
 pub mod reduce;

@@ -3,10 +3,12 @@
 //! `Xᵀ dY` (split-K over the batch), the bias gradient (column sums) and the ReLU backward.
 //! Shapes are checked ([`ShapeError`] names the operation and the sizes); outputs are new
 //! buffers. Every sum runs in an order fixed by the shapes alone, so the results are the same
-//! bits on every run of one device.
+//! bits on every run of one device. The three products take a [`Precision`]: f32 operands on
+//! the tiled kernels of [`crate::gemm`], or bf16 operands on tensor cores
+//! ([`crate::gemm_cmma`], where the device has them; sums in f32 either way).
 
 use crate::gemm::Tiling;
-use crate::{elementwise, gemm, reduce};
+use crate::{elementwise, gemm, gemm_cmma, reduce};
 use cubecl::prelude::*;
 use cubecl::server::Handle;
 use std::cell::Cell;
@@ -57,9 +59,90 @@ impl Matrix {
     }
 }
 
-/// Operands whose shapes do not fit the operation.
+/// An operation that cannot run: operands whose shapes do not fit it, or a [`Precision`] the
+/// device lacks. The message names the operation.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ShapeError(pub String);
+
+/// The precision of a product's operands; its sums are f32 either way.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Precision {
+    /// f32 operands, on every device and every [`Tiling`].
+    #[default]
+    F32,
+    /// Operands rounded to bf16 (8 bits of mantissa), multiplied on tensor cores
+    /// ([`crate::gemm_cmma`]); only where [`bf16_supported`] (CUDA on Ampere or later), and
+    /// only for products large enough to gain ([`takes_bf16`]; the others run in f32). The
+    /// tile is the kernel's own; [`set_tiling`] does not apply.
+    Bf16,
+}
+
+/// Whether `client`'s device runs [`Precision::Bf16`] products.
+pub fn bf16_supported(client: &Client) -> bool {
+    gemm_cmma::bf16_supported(client)
+}
+
+/// Whether an m x k by k x n product asked for in [`Precision::Bf16`] takes the tensor cores:
+/// products that gain nothing (narrow outputs such as a 3-channel head, a short k, small
+/// products) stay f32. The rule of the CPU's bf16 products (`cpu_kernels::takes_bf16`), so that
+/// both train the same products in bf16.
+pub fn takes_bf16(m: u32, n: u32, k: u32) -> bool {
+    n >= 16 && k >= 8 && u64::from(m) * u64::from(n) * u64::from(k) >= 1 << 18
+}
+
+/// The precision an m x k by k x n product asked for in `precision` runs in ([`takes_bf16`]).
+fn effective(precision: Precision, m: u32, n: u32, k: u32) -> Precision {
+    match precision {
+        Precision::Bf16 if takes_bf16(m, n, k) => Precision::Bf16,
+        _ => Precision::F32,
+    }
+}
+
+/// The tile of C one cube computes for a product in `precision` on `tiling`.
+fn tile_of(precision: Precision, tiling: Tiling) -> u32 {
+    match precision {
+        Precision::F32 => tiling.tile(),
+        Precision::Bf16 => gemm_cmma::TILE,
+    }
+}
+
+/// Refuses `precision` where the device cannot run it.
+fn check_precision(client: &Client, op: &str, precision: Precision) -> Result<(), ShapeError> {
+    check(precision == Precision::F32 || bf16_supported(client), || {
+        format!(
+            "{op}: bf16 products need tensor cores that multiply bf16 fragments (CubeCL's cmma, \
+             16 x 16 x 16 into f32: CUDA on Ampere or later), and this device has none"
+        )
+    })
+}
+
+/// Launches the product `c = a b` of `shape` in `precision` (see [`gemm::launch_gemm`]).
+///
+/// # Safety
+/// As [`gemm::launch_gemm`]; `precision` checked with [`check_precision`].
+#[allow(clippy::too_many_arguments)]
+unsafe fn launch_product(
+    client: &Client,
+    precision: Precision,
+    handles: [Handle; 4],
+    lens: [usize; 4],
+    shape: gemm::GemmShape,
+    splits: u32,
+    epilogue: gemm::Epilogue,
+) {
+    let [a, b, bias, c] = handles;
+    // SAFETY: the caller's.
+    unsafe {
+        match precision {
+            Precision::F32 => {
+                gemm::launch_gemm(client, a, b, bias, c, lens, shape, splits, epilogue);
+            }
+            Precision::Bf16 => {
+                gemm_cmma::launch_gemm_cmma(client, a, b, bias, c, lens, shape, splits, epilogue);
+            }
+        }
+    }
+}
 
 impl std::fmt::Display for ShapeError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -153,19 +236,23 @@ fn check_grid(op: &str, cubes: u32) -> Result<(), ShapeError> {
     check(cubes <= MAX_CUBES, || format!("{op}: {cubes} cubes along one axis exceed {MAX_CUBES}"))
 }
 
-/// `x W (+ bias) (ReLU)` for x `[rows, d_in]`, W `[d_in, d_out]`, bias `[d_out]`.
+/// `x W (+ bias) (ReLU)` for x `[rows, d_in]`, W `[d_in, d_out]`, bias `[d_out]`, the product
+/// in `precision`.
 pub fn forward(
     client: &Client,
     x: &Matrix,
     w: &Matrix,
     bias: Option<&Handle>,
     relu: bool,
+    precision: Precision,
 ) -> Result<Matrix, ShapeError> {
     check(x.cols == w.rows, || {
         format!("linear forward: x is {} x {} but W is {} x {}", x.rows, x.cols, w.rows, w.cols)
     })?;
+    check_precision(client, "linear forward", precision)?;
+    let precision = effective(precision, x.rows, w.cols, x.cols);
     let tiling = tiling();
-    check_grid("linear forward", x.rows.div_ceil(tiling.tile()))?;
+    check_grid("linear forward", x.rows.div_ceil(tile_of(precision, tiling)))?;
     let y = Matrix::empty(client, x.rows, w.cols);
     let epilogue = match (bias.is_some(), relu) {
         (false, false) => gemm::Epilogue::None,
@@ -187,12 +274,10 @@ pub fn forward(
     let bias_len = if bias.is_some() { w.cols as usize } else { 1 };
     // SAFETY: the shapes were checked against the matrices, whose buffers hold their elements.
     unsafe {
-        gemm::launch_gemm(
+        launch_product(
             client,
-            x.handle.clone(),
-            w.handle.clone(),
-            bias_handle,
-            y.handle.clone(),
+            precision,
+            [x.handle.clone(), w.handle.clone(), bias_handle, y.handle.clone()],
             [x.len(), w.len(), bias_len, y.len()],
             shape,
             1,
@@ -202,13 +287,21 @@ pub fn forward(
     Ok(y)
 }
 
-/// The input gradient `dY Wᵀ` `[rows, d_in]` for W `[d_in, d_out]` and dY `[rows, d_out]`.
-pub fn x_backward(client: &Client, w: &Matrix, dy: &Matrix) -> Result<Matrix, ShapeError> {
+/// The input gradient `dY Wᵀ` `[rows, d_in]` for W `[d_in, d_out]` and dY `[rows, d_out]`, in
+/// `precision`.
+pub fn x_backward(
+    client: &Client,
+    w: &Matrix,
+    dy: &Matrix,
+    precision: Precision,
+) -> Result<Matrix, ShapeError> {
     check(dy.cols == w.cols, || {
         format!("input gradient: dY is {} x {} but W is {} x {}", dy.rows, dy.cols, w.rows, w.cols)
     })?;
+    check_precision(client, "input gradient", precision)?;
+    let precision = effective(precision, dy.rows, w.rows, w.cols);
     let tiling = tiling();
-    check_grid("input gradient", dy.rows.div_ceil(tiling.tile()))?;
+    check_grid("input gradient", dy.rows.div_ceil(tile_of(precision, tiling)))?;
     let dx = Matrix::empty(client, dy.rows, w.rows);
     let shape = gemm::GemmShape {
         m: dy.rows,
@@ -221,12 +314,10 @@ pub fn x_backward(client: &Client, w: &Matrix, dy: &Matrix) -> Result<Matrix, Sh
     };
     // SAFETY: as in `forward`.
     unsafe {
-        gemm::launch_gemm(
+        launch_product(
             client,
-            dy.handle.clone(),
-            w.handle.clone(),
-            w.handle.clone(),
-            dx.handle.clone(),
+            precision,
+            [dy.handle.clone(), w.handle.clone(), w.handle.clone(), dx.handle.clone()],
             [dy.len(), w.len(), 1, dx.len()],
             shape,
             1,
@@ -258,13 +349,20 @@ pub fn bias_blocks(rows: u32) -> u32 {
 }
 
 /// The weight gradient `Xᵀ dY` `[d_in, d_out]` for x `[rows, d_in]` and dY `[rows, d_out]`:
-/// [`splits`] partial sums over blocks of rows, added in order.
-pub fn weight_backward(client: &Client, x: &Matrix, dy: &Matrix) -> Result<Matrix, ShapeError> {
+/// [`splits`] partial sums over blocks of rows (products in `precision`), added in order (f32).
+pub fn weight_backward(
+    client: &Client,
+    x: &Matrix,
+    dy: &Matrix,
+    precision: Precision,
+) -> Result<Matrix, ShapeError> {
     check(x.rows == dy.rows, || {
         format!("weight gradient: x is {} x {} but dY is {} x {}", x.rows, x.cols, dy.rows, dy.cols)
     })?;
+    check_precision(client, "weight gradient", precision)?;
+    let precision = effective(precision, x.cols, dy.cols, x.rows);
     let tiling = tiling();
-    let tile = tiling.tile();
+    let tile = tile_of(precision, tiling);
     let s = splits(x.rows, x.cols.div_ceil(tile) * dy.cols.div_ceil(tile));
     let shape = gemm::GemmShape {
         m: x.cols,
@@ -279,12 +377,10 @@ pub fn weight_backward(client: &Client, x: &Matrix, dy: &Matrix) -> Result<Matri
     let parts = if s == 1 { dw.clone() } else { Matrix::empty(client, s * x.cols, dy.cols) };
     // SAFETY: as in `forward`; `parts` holds `s` products.
     unsafe {
-        gemm::launch_gemm(
+        launch_product(
             client,
-            x.handle.clone(),
-            dy.handle.clone(),
-            dy.handle.clone(),
-            parts.handle.clone(),
+            precision,
+            [x.handle.clone(), dy.handle.clone(), dy.handle.clone(), parts.handle.clone()],
             [x.len(), dy.len(), 1, parts.len()],
             shape,
             s,

@@ -3,15 +3,39 @@
 //! the tiles and shapes that do not, one split and many, NaN and negative inputs through the ReLU, the same bits on a
 //! second run, the same bits from checked launches, and shape errors that name the operation.
 //!
-//! `cargo test -p gpu-kernels --features wgpu`
+//! The bf16 products on tensor cores (`Precision::Bf16`) are checked against an f64 reference
+//! of the bf16-rounded operands where the device has them, and must be refused, naming the
+//! operation, where it has not (lavapipe, any WGSL device).
+//!
+//! `cargo test -p gpu-kernels --features wgpu`; on an NVIDIA GPU also
+//! `GPU_KERNELS_RUNTIME=cuda cargo test -p gpu-kernels --features wgpu,cuda`.
 
 use cubecl::prelude::*;
 use gpu_kernels::checks;
 use gpu_kernels::gemm::Tiling;
+use gpu_kernels::linear::Precision::{Bf16, F32};
 use gpu_kernels::linear::{self, Matrix, TilingScope};
 
+/// The runtime under test: `GPU_KERNELS_RUNTIME=cuda` (with the `cuda` feature), else wgpu.
 fn client() -> Client {
-    cubecl::Device::Wgpu(Default::default()).client()
+    match std::env::var("GPU_KERNELS_RUNTIME").as_deref() {
+        Ok("cuda") if cfg!(feature = "cuda") => cubecl::Device::Cuda(Default::default()).client(),
+        Ok("wgpu") | Err(_) => cubecl::Device::Wgpu(Default::default()).client(),
+        Ok(other) => {
+            panic!("GPU_KERNELS_RUNTIME={other:?}: expected wgpu, or cuda when built with it")
+        }
+    }
+}
+
+/// `v` rounded to the nearest bf16 (ties to even), as the tensor-core kernel rounds.
+fn bf16_round(v: f32) -> f32 {
+    let bits = v.to_bits();
+    let rounded = bits.wrapping_add(0x7fff + ((bits >> 16) & 1)) & 0xffff_0000;
+    f32::from_bits(rounded)
+}
+
+fn rounded(v: &[f32]) -> Vec<f32> {
+    v.iter().copied().map(bf16_round).collect()
 }
 
 /// Deterministic values in [-1, 1) (xorshift).
@@ -92,16 +116,16 @@ fn forward_matches_on(tiling: Tiling) {
             plain.iter().enumerate().map(|(e, v)| v + bv[e % n] as f64).collect();
         let relu: Vec<f64> = with_bias.iter().map(|v| v.max(0.0)).collect();
         let tol = 4e-7 * k as f64;
-        let got = linear::forward(&client, &x, &w, None, false).unwrap().read(&client);
+        let got = linear::forward(&client, &x, &w, None, false, F32).unwrap().read(&client);
         assert_close(&format!("x W {rows}x{d_in}x{d_out} {tiling:?}"), &got, &plain, tol);
-        let got = linear::forward(&client, &x, &w, Some(&b.handle), false).unwrap();
+        let got = linear::forward(&client, &x, &w, Some(&b.handle), false, F32).unwrap();
         assert_close(
             &format!("x W + b {rows}x{d_in}x{d_out} {tiling:?}"),
             &got.read(&client),
             &with_bias,
             tol,
         );
-        let got = linear::forward(&client, &x, &w, Some(&b.handle), true).unwrap();
+        let got = linear::forward(&client, &x, &w, Some(&b.handle), true, F32).unwrap();
         let label = format!("relu {rows}x{d_in}x{d_out} {tiling:?}");
         assert_close(&label, &got.read(&client), &relu, tol);
     }
@@ -127,11 +151,11 @@ fn gradients_match_on(tiling: Tiling) {
         let dy = Matrix::upload(&client, &dyv, rows, d_out).unwrap();
         let label = format!("{rows}x{d_in}x{d_out} {tiling:?}");
 
-        let dx = linear::x_backward(&client, &w, &dy).unwrap().read(&client);
+        let dx = linear::x_backward(&client, &w, &dy, F32).unwrap().read(&client);
         let want = product(&dyv, &transpose(&wv, k, n), m, n, k);
         assert_close(&format!("dY Wᵀ {label}"), &dx, &want, 4e-7 * n as f64);
 
-        let dw = linear::weight_backward(&client, &x, &dy).unwrap();
+        let dw = linear::weight_backward(&client, &x, &dy, F32).unwrap();
         let want = product(&transpose(&xv, m, k), &dyv, k, m, n);
         assert_close(&format!("Xᵀ dY {label}"), &dw.read(&client), &want, 4e-7 * m as f64);
 
@@ -151,8 +175,8 @@ fn results_are_the_same_bits_on_a_second_run() {
     let dy = Matrix::upload(&client, &dyv, rows, d_out).unwrap();
     assert_eq!(linear::splits(rows, 4), 64);
     assert_eq!(linear::bias_blocks(rows), 157);
-    let first = linear::weight_backward(&client, &x, &dy).unwrap().read(&client);
-    let second = linear::weight_backward(&client, &x, &dy).unwrap().read(&client);
+    let first = linear::weight_backward(&client, &x, &dy, F32).unwrap().read(&client);
+    let second = linear::weight_backward(&client, &x, &dy, F32).unwrap().read(&client);
     assert!(first.iter().zip(&second).all(|(a, b)| a.to_bits() == b.to_bits()));
     let first = linear::bias_backward(&client, &dy).unwrap().read(&client);
     let second = linear::bias_backward(&client, &dy).unwrap().read(&client);
@@ -167,11 +191,11 @@ fn all_outputs(client: &Client, tiling: Tiling) -> Vec<Vec<f32>> {
     let w = Matrix::upload(client, &values((d_in * d_out) as usize, 12), d_in, d_out).unwrap();
     let b = Matrix::upload(client, &values(d_out as usize, 13), 1, d_out).unwrap();
     let dy = Matrix::upload(client, &values((rows * d_out) as usize, 14), rows, d_out).unwrap();
-    let y = linear::forward(client, &x, &w, Some(&b.handle), true).unwrap();
+    let y = linear::forward(client, &x, &w, Some(&b.handle), true, F32).unwrap();
     vec![
         y.read(client),
-        linear::x_backward(client, &w, &dy).unwrap().read(client),
-        linear::weight_backward(client, &x, &dy).unwrap().read(client),
+        linear::x_backward(client, &w, &dy, F32).unwrap().read(client),
+        linear::weight_backward(client, &x, &dy, F32).unwrap().read(client),
         linear::bias_backward(client, &dy).unwrap().read(client),
         linear::relu_backward(client, &y, &dy).unwrap().read(client),
     ]
@@ -215,7 +239,7 @@ fn relu_keeps_nan_and_its_backward_masks_the_gradient() {
     let x = Matrix::upload(&client, &finite, 1, n).unwrap();
     let w = Matrix::upload(&client, &id, n, n).unwrap();
     let b = Matrix::upload(&client, &vec![0.0; n as usize], 1, n).unwrap();
-    let y = linear::forward(&client, &x, &w, Some(&b.handle), true).unwrap().read(&client);
+    let y = linear::forward(&client, &x, &w, Some(&b.handle), true, F32).unwrap().read(&client);
     let want: Vec<f64> = finite.iter().map(|v| (*v as f64).max(0.0)).collect();
     assert_close("fused ReLU", &y, &want, 0.0);
 
@@ -230,12 +254,75 @@ fn mismatched_shapes_are_errors_that_name_the_operation() {
     let client = client();
     let x = Matrix::upload(&client, &values(6, 1), 2, 3).unwrap();
     let w = Matrix::upload(&client, &values(8, 2), 4, 2).unwrap();
-    let e = linear::forward(&client, &x, &w, None, false).unwrap_err().to_string();
+    let e = linear::forward(&client, &x, &w, None, false, F32).unwrap_err().to_string();
     assert!(e.contains("linear forward") && e.contains("2 x 3") && e.contains("4 x 2"), "{e}");
-    let e = linear::weight_backward(&client, &x, &w).unwrap_err().to_string();
+    let e = linear::weight_backward(&client, &x, &w, F32).unwrap_err().to_string();
     assert!(e.contains("weight gradient"), "{e}");
-    let e = linear::x_backward(&client, &w, &x).unwrap_err().to_string();
+    let e = linear::x_backward(&client, &w, &x, F32).unwrap_err().to_string();
     assert!(e.contains("input gradient"), "{e}");
     let e = Matrix::upload(&client, &values(5, 1), 2, 3).unwrap_err().to_string();
     assert!(e.contains("5 values for a 2 x 3"), "{e}");
+}
+
+/// bf16 products: on a device with tensor cores, the three products against an f64 reference of
+/// the operands rounded to bf16 (their products are exact in f32, so only the f32 sums differ);
+/// elsewhere each product is refused with an error that names it.
+#[test]
+fn bf16_products_match_the_rounded_reference_or_are_refused() {
+    let client = client();
+    if !linear::bf16_supported(&client) {
+        let x = Matrix::upload(&client, &values(4, 1), 2, 2).unwrap();
+        let refusals = [
+            ("linear forward", linear::forward(&client, &x, &x, None, false, Bf16)),
+            ("input gradient", linear::x_backward(&client, &x, &x, Bf16)),
+            ("weight gradient", linear::weight_backward(&client, &x, &x, Bf16)),
+        ];
+        for (op, result) in refusals {
+            let e = result.unwrap_err().to_string();
+            assert!(e.contains(op) && e.contains("bf16") && e.contains("tensor cores"), "{e}");
+        }
+        eprintln!("this device has no bf16 tensor cores: checked the refusals only");
+        return;
+    }
+    for (t, &(rows, d_in, d_out)) in SHAPES.iter().enumerate() {
+        let (m, k, n) = (rows as usize, d_in as usize, d_out as usize);
+        let xv = values(m * k, 600 + t as u64);
+        let wv = values(k * n, 700 + t as u64);
+        let bv = values(n, 800 + t as u64);
+        let dyv = values(m * n, 900 + t as u64);
+        let x = Matrix::upload(&client, &xv, rows, d_in).unwrap();
+        let w = Matrix::upload(&client, &wv, d_in, d_out).unwrap();
+        let b = Matrix::upload(&client, &bv, 1, d_out).unwrap();
+        let dy = Matrix::upload(&client, &dyv, rows, d_out).unwrap();
+        let label = format!("bf16 {rows}x{d_in}x{d_out}");
+        // The operands as the product sees them: rounded where it takes the tensor cores.
+        let seen = |v: &[f32], (m, n, k): (u32, u32, u32)| {
+            if linear::takes_bf16(m, n, k) { rounded(v) } else { v.to_vec() }
+        };
+
+        let fwd = (rows, d_out, d_in);
+        let y = linear::forward(&client, &x, &w, Some(&b.handle), true, Bf16).unwrap();
+        let want: Vec<f64> = product(&seen(&xv, fwd), &seen(&wv, fwd), m, k, n)
+            .iter()
+            .enumerate()
+            .map(|(e, v)| (v + bv[e % n] as f64).max(0.0))
+            .collect();
+        assert_close(&format!("relu(x W + b) {label}"), &y.read(&client), &want, 4e-7 * k as f64);
+
+        let xb = (rows, d_in, d_out);
+        let dx = linear::x_backward(&client, &w, &dy, Bf16).unwrap().read(&client);
+        let want = product(&seen(&dyv, xb), &transpose(&seen(&wv, xb), k, n), m, n, k);
+        assert_close(&format!("dY Wᵀ {label}"), &dx, &want, 4e-7 * n as f64);
+
+        let wb = (d_in, d_out, rows);
+        let dw = linear::weight_backward(&client, &x, &dy, Bf16).unwrap().read(&client);
+        let want = product(&transpose(&seen(&xv, wb), m, k), &seen(&dyv, wb), k, m, n);
+        assert_close(&format!("Xᵀ dY {label}"), &dw, &want, 4e-7 * m as f64);
+
+        // Rounding is what changed where the tensor cores ran.
+        if linear::takes_bf16(rows, d_out, d_in) {
+            let f32_y = linear::forward(&client, &x, &w, Some(&b.handle), true, F32).unwrap();
+            assert_ne!(f32_y.read(&client), y.read(&client), "{label}: bf16 gave the f32 result");
+        }
+    }
 }
