@@ -21,8 +21,8 @@
 //!   `BRDF_BENCH_RATES=0` skips the gemm and product rates and prints nothing (for `perf`);
 //! - `BRDF_KEEP_MALLOC=0` turns the host-memory policy off (`brdf_neural::host_memory`);
 //! - `BRDF_BENCH_PRECISION=f32,bf16` (default `f32`) also times every step with bf16 matrix
-//!   products ([`brdf_neural::precision`], flex only), with the PyTorch comparison under bf16
-//!   autocast, and the flex products themselves in both precisions;
+//!   products ([`brdf_neural::precision`], flex and cuda: tensor cores), with the PyTorch
+//!   comparison under bf16 autocast, and the flex products themselves in both precisions;
 //! - `BRDF_BENCH_SPLIT=1,64` times every step with its linear layers' batch split into these
 //!   numbers of parts ([`brdf_neural::split_k`]; default: what the trainer uses, 1 on the
 //!   CPU and [`brdf_neural::split_k::gpu_parts`] on a GPU), and, on a GPU backend, prints
@@ -402,7 +402,7 @@ fn bench(cr: &mut Criterion) {
          {:.1} GFLOP/s (split over the batch, one thread a half: {:.1} GFLOP/s)",
         rates.forward, rates.weight_grad, rates.weight_grad_split
     );
-    if precisions().contains(&MatmulPrecision::Bf16) {
+    if precisions().contains(&MatmulPrecision::Bf16) && backends().contains(&Backend::Flex) {
         let r = flex_product_rates(n);
         println!(
             "flex products through burn (allocation included), f32 -> bf16 GFLOP/s: \
@@ -489,12 +489,12 @@ fn precisions() -> Vec<MatmulPrecision> {
         .collect()
 }
 
-/// Every backend with every precision it implements (bf16: flex only) and every split.
+/// Every backend with every precision it implements (bf16: flex and cuda) and every split.
 fn backends_and_precisions(n: usize) -> Vec<(Backend, MatmulPrecision, usize)> {
     let mut out = Vec::new();
     for b in backends() {
         for p in precisions() {
-            if p == MatmulPrecision::F32 || b == Backend::Flex {
+            if p.scope(b).is_ok() {
                 out.extend(splits(b, n).into_iter().map(|s| (b, p, s)));
             }
         }

@@ -5,8 +5,10 @@
 //! The kernels take row-major f32 matrices: an operand with other strides is first made
 //! contiguous (burn's own kernel), and a tensor of another float type, or a shape past the
 //! kernels' grid limits, takes burn's own operations instead, so every input has an answer.
-//! Each layer's products run in f32 ([`MatmulPrecision::Bf16`] is refused off the CPU by
-//! [`MatmulPrecision::scope`]).
+//! A layer's products run in the precision the layer hands over: f32, or
+//! [`MatmulPrecision::Bf16`] on tensor cores (`gpu_kernels::gemm_cmma`; CUDA on Ampere or
+//! later; [`MatmulPrecision::scope`] refuses bf16 on wgpu, whose WGSL has no such
+//! instructions). A CUDA device without them runs the products in f32, and says so once.
 
 use crate::linear_op::LinearKernels;
 use crate::precision::MatmulPrecision;
@@ -15,9 +17,29 @@ use burn::backend::tensor::FloatTensor;
 use burn::tensor::{DType, Shape};
 use burn_cubecl::CubeBackend;
 use burn_cubecl::tensor::CubeTensor;
-use gpu_kernels::linear::{self as kernels, Matrix};
+use gpu_kernels::linear::{self as kernels, Matrix, Precision};
+use std::sync::Once;
 
 type B = CubeBackend;
+
+/// The kernels' spelling of `p` on `client`'s device: bf16 where it has tensor cores for it,
+/// else f32 (with a warning, once a process).
+fn kernel_precision(client: &cubecl::prelude::Client, p: MatmulPrecision) -> Precision {
+    match p {
+        MatmulPrecision::F32 => Precision::F32,
+        MatmulPrecision::Bf16 if kernels::bf16_supported(client) => Precision::Bf16,
+        MatmulPrecision::Bf16 => {
+            static WARNED: Once = Once::new();
+            WARNED.call_once(|| {
+                eprintln!(
+                    "warning: matmul_precision = \"bf16\" on a GPU without bf16 tensor cores \
+                     (CubeCL's cmma; CUDA on Ampere or later): the products run in f32"
+                )
+            });
+            Precision::F32
+        }
+    }
+}
 
 /// The tensor as a row-major matrix (made contiguous first where it is not), or `None` for a
 /// type other than f32 or a shape that is not 2-d.
@@ -57,11 +79,12 @@ impl LinearKernels for CubeBackend {
         x: FloatTensor<Self>,
         weight: FloatTensor<Self>,
         bias: FloatTensor<Self>,
-        _precision: MatmulPrecision,
+        precision: MatmulPrecision,
     ) -> FloatTensor<Self> {
         if let (Some((xt, xm)), Some((_, wm)), Some((_, bm))) =
             (matrix(x.clone()), matrix(weight.clone()), matrix(row(bias.clone())))
-            && let Ok(y) = kernels::forward(&xt.client, &xm, &wm, Some(&bm.handle), false)
+            && let p = kernel_precision(&xt.client, precision)
+            && let Ok(y) = kernels::forward(&xt.client, &xm, &wm, Some(&bm.handle), false, p)
         {
             let shape = Shape::new([y.rows as usize, y.cols as usize]);
             return tensor(&xt, y, shape);
@@ -72,10 +95,11 @@ impl LinearKernels for CubeBackend {
     fn kernel_linear_no_bias(
         x: FloatTensor<Self>,
         weight: FloatTensor<Self>,
-        _precision: MatmulPrecision,
+        precision: MatmulPrecision,
     ) -> FloatTensor<Self> {
         if let (Some((xt, xm)), Some((_, wm))) = (matrix(x.clone()), matrix(weight.clone()))
-            && let Ok(y) = kernels::forward(&xt.client, &xm, &wm, None, false)
+            && let p = kernel_precision(&xt.client, precision)
+            && let Ok(y) = kernels::forward(&xt.client, &xm, &wm, None, false, p)
         {
             let shape = Shape::new([y.rows as usize, y.cols as usize]);
             return tensor(&xt, y, shape);
@@ -86,11 +110,12 @@ impl LinearKernels for CubeBackend {
     fn kernel_linear_x_backward(
         weight: FloatTensor<Self>,
         output_grad: FloatTensor<Self>,
-        _precision: MatmulPrecision,
+        precision: MatmulPrecision,
     ) -> FloatTensor<Self> {
         if let (Some((_, wm)), Some((gt, gm))) =
             (matrix(weight.clone()), matrix(output_grad.clone()))
-            && let Ok(dx) = kernels::x_backward(&gt.client, &wm, &gm)
+            && let p = kernel_precision(&gt.client, precision)
+            && let Ok(dx) = kernels::x_backward(&gt.client, &wm, &gm, p)
         {
             let shape = Shape::new([dx.rows as usize, dx.cols as usize]);
             return tensor(&gt, dx, shape);
@@ -101,10 +126,11 @@ impl LinearKernels for CubeBackend {
     fn kernel_linear_weight_backward(
         x: FloatTensor<Self>,
         output_grad: FloatTensor<Self>,
-        _precision: MatmulPrecision,
+        precision: MatmulPrecision,
     ) -> FloatTensor<Self> {
         if let (Some((xt, xm)), Some((_, gm))) = (matrix(x.clone()), matrix(output_grad.clone()))
-            && let Ok(dw) = kernels::weight_backward(&xt.client, &xm, &gm)
+            && let p = kernel_precision(&xt.client, precision)
+            && let Ok(dw) = kernels::weight_backward(&xt.client, &xm, &gm, p)
         {
             let shape = Shape::new([dw.rows as usize, dw.cols as usize]);
             return tensor(&xt, dw, shape);

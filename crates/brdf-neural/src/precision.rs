@@ -6,7 +6,9 @@
 //! activations, gradients and Adam stay f32. On Intel CPUs with AMX the products run on its tiles
 //! (`tdpbf16ps`), on other CPUs with AVX512-BF16 at twice the multiply-adds per instruction of
 //! f32 (`vdpbf16ps`), both in the `cpu-kernels` crate; elsewhere the same rounding is emulated,
-//! slower than f32. Only the flex CPU backend implements it.
+//! slower than f32. On an NVIDIA GPU (`--backend cuda`, Ampere or later) the products run on
+//! tensor cores (`gpu-kernels`' `gemm_cmma`), PyTorch's bf16 autocast for the linear layers.
+//! The flex and cuda backends implement it; the others refuse it.
 //!
 //! The setting belongs to the training loop of one thread: [`MatmulPrecision::scope`] applies
 //! it to the linear layers of the models that thread runs until the returned guard drops, so an
@@ -49,19 +51,39 @@ impl MatmulPrecision {
     /// until the guard drops.
     ///
     /// # Errors
-    /// [`crate::Error::Spec`] (an invalid configuration) for bf16 on a backend other than flex.
+    /// [`crate::Error::Spec`] (an invalid configuration) for bf16 on a backend other than flex
+    /// and cuda, and on cuda with burn's kernels for the linear layers
+    /// (`NEURAL_BRDF_GPU_LINEAR=burn`, [`crate::gpu_linear`]).
     pub fn scope(self, backend: crate::device::Backend) -> crate::Result<PrecisionGuard> {
+        use crate::device::Backend;
+        use crate::gpu_linear::GpuLinear;
         if self == MatmulPrecision::F32 {
             return Ok(PrecisionGuard { previous: None });
         }
-        if backend != crate::device::Backend::Flex {
-            return Err(model_spec::Error::InvalidConfig(format!(
-                "matmul precision bf16 is implemented for the flex CPU backend only, not {}",
-                backend.name()
-            ))
-            .into());
+        let refused = match backend {
+            Backend::Flex => None,
+            Backend::Cuda if GpuLinear::current() == GpuLinear::Ours => None,
+            Backend::Cuda => Some(format!(
+                "matmul precision bf16 on cuda runs on this workspace's GPU kernels, not burn's \
+                 ({}=burn): unset it",
+                crate::gpu_linear::VAR
+            )),
+            Backend::Wgpu => Some(
+                "matmul precision bf16 needs tensor cores, which wgpu's shading language (WGSL) \
+                 cannot reach: on an NVIDIA GPU use --backend cuda (Ampere or later), or train \
+                 in f32"
+                    .to_string(),
+            ),
+            other => Some(format!(
+                "matmul precision bf16 is implemented for the flex CPU backend and for cuda, not \
+                 {}",
+                other.name()
+            )),
+        };
+        match refused {
+            Some(why) => Err(model_spec::Error::InvalidConfig(why).into()),
+            None => Ok(PrecisionGuard { previous: Some(set(self)) }),
         }
-        Ok(PrecisionGuard { previous: Some(set(self)) })
     }
 
     /// Plain f32 products on the calling thread until the guard drops, whatever was set before

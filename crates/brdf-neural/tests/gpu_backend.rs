@@ -147,6 +147,29 @@ fn the_split_k_trains_along_the_same_loss_curve_on_the_gpu() {
     assert_close(&l_gpu, &l_cpu, 1e-3, "loss curve with the batch split");
 }
 
+/// bf16 products on the GPU (tensor cores: `--backend cuda` on Ampere or later): a Single MLP
+/// trained in bf16 follows the CPU's bf16 loss curve (the same products rounded to bf16 by the
+/// same rule, f32 sums in another order). On wgpu, whose shading language has no tensor-core
+/// instructions, bf16 is refused, and the refusal says where it runs.
+#[test]
+fn bf16_trains_along_the_cpus_bf16_curve_or_is_refused() {
+    use brdf_neural::precision::MatmulPrecision;
+    let backend = gpu();
+    let guard = match MatmulPrecision::Bf16.scope(backend) {
+        Ok(guard) => guard,
+        Err(e) => {
+            let e = e.to_string();
+            assert!(backend == Backend::Wgpu && e.contains("--backend cuda"), "{backend}: {e}");
+            return;
+        }
+    };
+    let c = small(ModelKind::SingleMlp);
+    let data = curve_data(&c, 11);
+    let (l_cpu, l_gpu, _) = loss_curves(&c, &data, 8, 1);
+    drop(guard);
+    assert_close(&l_gpu, &l_cpu, 1e-2, "bf16 loss curve");
+}
+
 /// The linear layers take the kernels `NEURAL_BRDF_GPU_LINEAR` names: `gpu-kernels` for
 /// `ours` on a GPU tensor, burn's otherwise, and never ours on a CPU tensor.
 #[test]

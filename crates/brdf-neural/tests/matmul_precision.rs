@@ -213,11 +213,18 @@ fn narrow_and_small_products_stay_f32_under_bf16() {
 }
 
 #[test]
-fn bf16_is_refused_off_the_cpu_backend() {
-    for backend in Backend::ALL {
-        if backend != Backend::Flex {
-            assert!(MatmulPrecision::Bf16.scope(backend).is_err(), "{backend}");
-        }
+fn bf16_is_refused_where_no_kernel_implements_it() {
+    for backend in [Backend::NdArray, Backend::Wgpu] {
+        let e = MatmulPrecision::Bf16.scope(backend).err().expect("refused").to_string();
+        assert!(e.contains("bf16"), "{backend}: {e}");
+    }
+    // wgpu's refusal says where bf16 runs on a GPU.
+    let e = MatmulPrecision::Bf16.scope(Backend::Wgpu).err().expect("refused").to_string();
+    assert!(e.contains("--backend cuda") && e.contains("tensor cores"), "{e}");
+    assert!(MatmulPrecision::Bf16.scope(Backend::Flex).is_ok());
+    // On cuda, the gpu-kernels' tensor-core products (the default kernels) implement it.
+    if std::env::var(brdf_neural::gpu_linear::VAR).is_err() {
+        assert!(MatmulPrecision::Bf16.scope(Backend::Cuda).is_ok());
     }
     assert!(MatmulPrecision::F32.scope(Backend::Wgpu).is_ok());
 }

@@ -271,17 +271,15 @@ pub fn fit_and_keep(
     };
     // The matrix-product precision of this thread's training steps; evaluation keeps f32.
     let precision = t.matmul_precision.scope(options.backend)?;
-    if t.matmul_precision == MatmulPrecision::Bf16 && !MatmulPrecision::bf16_native() {
+    let cpu_bf16 = t.matmul_precision == MatmulPrecision::Bf16 && !options.backend.is_gpu();
+    if cpu_bf16 && !MatmulPrecision::bf16_native() {
         eprintln!(
             "{}: warning: matmul_precision = \"bf16\" on a CPU without AVX512-BF16: the products \
              are emulated, about 2x slower a step than f32 (measured on an Intel Xeon \
              without it); f32 is the faster choice here",
             run.display()
         );
-    } else if t.matmul_precision == MatmulPrecision::Bf16
-        && MatmulPrecision::cpu_has_amx_bf16()
-        && !MatmulPrecision::bf16_on_amx()
-    {
+    } else if cpu_bf16 && MatmulPrecision::cpu_has_amx_bf16() && !MatmulPrecision::bf16_on_amx() {
         eprintln!(
             "{}: warning: matmul_precision = \"bf16\" on an Intel CPU with AMX, but the AMX \
              kernel is off (CPU_KERNELS_AMX=0, or Linux refused the tile registers): the products \

@@ -61,7 +61,8 @@
 //! so that an untrained model renders at the right brightness; `adam_epsilon` defaults to
 //! PyTorch's 1e-8 (burn's own default, 1e-5, damps every update whose gradient is that small).
 //! `matmul_precision = "bf16"` trains with the network's large matrix products on bf16 operands
-//! and f32 sums ([`brdf_neural::precision`], the CPU backend only; evaluation stays f32);
+//! and f32 sums ([`brdf_neural::precision`]: flex on the CPU, cuda on tensor cores; evaluation
+//! stays f32);
 //! `docs/reproduce.md` gives its measured speed and what it does to the converged scores.
 
 use crate::{Error, Result};
