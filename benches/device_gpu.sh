@@ -27,6 +27,10 @@
 #                                        # with 4-wide shared reads (64v, 128v): one layer's
 #                                        # products, every kind beside PyTorch, the loop with
 #                                        # FMBRDF's dense Lambda network, the start-up
+#   bash benches/device_gpu.sh cuda      # CubeCL's CUDA runtime (NVRTC) against wgpu, and bf16
+#                                        # products on tensor cores: correctness, one layer,
+#                                        # every kind beside PyTorch f32 and bf16 autocast, the
+#                                        # loop in f32 and bf16
 #
 # With autotune on (the wgpu feature), the first use of every matrix-product shape in a process
 # is benchmarked, and the first process on a fresh machine also compiles every kernel and runs
@@ -407,6 +411,56 @@ if [ "$STAGE" = checks ]; then
     nvidia-smi dmon -s u -d 1 -o T >"$LOGS/gpu_use.log" 2>&1 &
     DMON=$!
     run 60 loop.log $B/profile_steps /tmp/default spot__blue-acrylic 1400 wgpu SingleMlp,Fmbrdf
+    kill $DMON
+fi
+if [ "$STAGE" = cuda ]; then
+    # CubeCL's CUDA runtime instead of wgpu: its kernels compiled by NVRTC (the image's CUDA
+    # toolkit, else the nvidia-cuda-nvrtc wheel PyTorch brings), the same gpu-kernels, burn's
+    # fusion on CUDA; and the bf16 products on tensor cores (gpu_kernels::gemm_cmma,
+    # matmul_precision = "bf16"). Correctness first (gpu-kernels' tests against the f64
+    # reference, f32 on every tiling and bf16; every kind against the CPU), then one layer's
+    # products at 2^15 rows on every variant, every kind's step at 2^15 on cuda in f32 and bf16
+    # back to back with PyTorch eager f32 and bf16 autocast (one round), the wgpu step for the
+    # comparison of runtimes, and the default run's Single MLP and FMBRDF loop on cuda in f32
+    # and bf16 with `nvidia-smi dmon`. One call: DEVICE_DEADLINE=500 bash benches/device_gpu.sh cuda
+    export PYTHONPATH=$PWD/crates/py-neural-brdfs/python${PYTHONPATH:+:$PYTHONPATH}
+    export NEURAL_BRDF_GPU_CACHE=/tmp/gpu-cache NEURAL_BRDF_GPU_LINEAR=ours
+    python3 -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name(0))"
+    step "NVRTC for CubeCL's CUDA runtime"
+    nvrtc_dirs=$(python3 - <<'PY'
+import glob, os, site
+dirs = ["/usr/local/cuda/lib64", "/usr/local/cuda/targets/x86_64-linux/lib"]
+for root in site.getsitepackages():
+    dirs += glob.glob(os.path.join(root, "nvidia", "*", "lib"))
+print(":".join(d for d in dirs if glob.glob(os.path.join(d, "libnvrtc.so*"))))
+PY
+)
+    echo "libnvrtc in: ${nvrtc_dirs:-nowhere}"
+    export LD_LIBRARY_PATH=${nvrtc_dirs}${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+    [ -d /usr/local/cuda ] && export CUDA_PATH=${CUDA_PATH:-/usr/local/cuda}
+    step "gpu-kernels on CUDA against the f64 reference: f32 on every tiling, bf16 on tensor cores"
+    run 90 kernels_cuda.log env GPU_KERNELS_RUNTIME=cuda $B/kernels --test-threads=1 --nocapture
+    step "CUDA against the CPU on this GPU, every kind's values and gradients"
+    run 60 gpu_backend_cuda.log env BRDF_GPU_BACKEND=cuda $B/gpu_backend --test-threads=1
+    step "one layer's products at 2^15 rows on CUDA: 64, 64 checked, 128, 64v, 128v, bf16"
+    run 50 layer_cuda.log env GPU_KERNELS_RUNTIME=cuda GPU_KERNELS_BENCH_ROWS=32768 $B/layer \
+        --bench --warm-up-time 1 --measurement-time 1
+    step "the cuda step, all 9 kinds, f32 and bf16, against PyTorch eager f32 and bf16 autocast"
+    run 150 step_cuda.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_ALL_MODELS=1 \
+        BRDF_BENCH_BACKENDS=cuda BRDF_BENCH_PRECISION=f32,bf16 BRDF_BENCH_RATES=0 \
+        BRDF_BENCH_PYTORCH=python3 BRDF_BENCH_PYTORCH_ROUNDS=1 $B/train_step --bench
+    step "the wgpu step, all 9 kinds (the runtimes side by side)"
+    run 60 step_wgpu.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_ALL_MODELS=1 \
+        BRDF_BENCH_BACKENDS=wgpu BRDF_BENCH_RATES=0 $B/train_step --bench
+    export PROFILE_WARMUP_STEPS=50 PROFILE_EVAL=none
+    run 30 default_scenes.log $B/profile_steps --prepare default /tmp/default
+    nvidia-smi dmon -s u -d 1 -o T >"$LOGS/gpu_use.log" 2>&1 &
+    DMON=$!
+    for precision in f32 bf16; do
+        echo "== $(date +%T) $precision" >>"$LOGS/gpu_use.log"
+        run 50 "loop_cuda_$precision.log" env PROFILE_PRECISION=$precision $B/profile_steps \
+            /tmp/default spot__blue-acrylic 1400 cuda SingleMlp,Fmbrdf
+    done
     kill $DMON
 fi
 step "done"

@@ -26,6 +26,9 @@
 //! a GPU backend's start-up in the first evaluation shows against the later ones; the table
 //! holds the last.
 //!
+//! `PROFILE_PRECISION` (`f32` or `bf16`) sets the runs' `matmul_precision` (default: the
+//! sweep's).
+//!
 //! On a GPU backend each model first trains `PROFILE_WARMUP_STEPS` steps (default 50; 0 on the
 //! CPU) in a run of its own, timed apart: burn's autotune benchmarks kernels at the first use of
 //! each problem shape in a process, and that start-up would otherwise be spread over the
@@ -99,11 +102,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
          bookkeeping | total | samples/s |"
     );
     println!("| --- |{}", " ---: |".repeat(10));
+    let precision = match std::env::var("PROFILE_PRECISION").as_deref() {
+        Ok("f32") => Some(brdf_neural::precision::MatmulPrecision::F32),
+        Ok("bf16") => Some(brdf_neural::precision::MatmulPrecision::Bf16),
+        Ok(other) => {
+            return Err(format!("PROFILE_PRECISION={other:?}: expected f32 or bf16").into());
+        }
+        Err(_) => None,
+    };
     let mut evals = Vec::new();
     let mut warmups = Vec::new();
     for template in &runs {
         let mut config = RunDir::new(template).read_config()?;
         config.train.iterations = steps;
+        if let Some(p) = precision {
+            config.train.matmul_precision = p;
+        }
         config.train.snapshots = false;
         let kind = format!("{:?}", config.model.kind);
         if only.as_ref().is_some_and(|o| !o.contains(&kind.as_str())) {
