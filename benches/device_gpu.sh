@@ -435,9 +435,22 @@ for root in site.getsitepackages():
 print(":".join(d for d in dirs if glob.glob(os.path.join(d, "libnvrtc.so*"))))
 PY
 )
+    # NVRTC also needs the toolkit's headers (cubecl-cuda passes $CUDA_PATH/include).
+    if [ -z "${CUDA_PATH:-}" ]; then
+        if [ -d /usr/local/cuda/include ]; then
+            export CUDA_PATH=/usr/local/cuda
+        elif command -v nvcc >/dev/null; then
+            CUDA_PATH=$(dirname "$(dirname "$(readlink -f "$(command -v nvcc)")")")
+            export CUDA_PATH
+        fi
+    fi
+    echo "CUDA_PATH=${CUDA_PATH:-unset}"
+    ls "${CUDA_PATH:-/nonexistent}/include/cuda_bf16.h"
+    for d in "${CUDA_PATH:-/nonexistent}/lib64" "${CUDA_PATH:-/nonexistent}/lib"; do
+        ls "$d"/libnvrtc.so* >/dev/null 2>&1 && nvrtc_dirs=$d${nvrtc_dirs:+:$nvrtc_dirs}
+    done
     echo "libnvrtc in: ${nvrtc_dirs:-nowhere}"
     export LD_LIBRARY_PATH=${nvrtc_dirs}${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
-    [ -d /usr/local/cuda ] && export CUDA_PATH=${CUDA_PATH:-/usr/local/cuda}
     step "gpu-kernels on CUDA against the f64 reference: f32 on every tiling, bf16 on tensor cores"
     run 90 kernels_cuda.log env GPU_KERNELS_RUNTIME=cuda $B/kernels --test-threads=1 --nocapture
     step "CUDA against the CPU on this GPU, every kind's values and gradients"
