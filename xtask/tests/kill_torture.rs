@@ -244,10 +244,46 @@ fn assert_same_results(a: &Path, b: &Path) -> usize {
         "the tortured sweep holds other files than the uninterrupted one: missing {only_a:?}, \
          extra {only_b:?}"
     );
-    for rel in &fa {
-        assert!(content(a, rel) == content(b, rel), "{} differs", rel.display());
-    }
+    let differing: Vec<String> = fa
+        .iter()
+        .filter_map(|rel| {
+            let (ca, cb) = (content(a, rel), content(b, rel));
+            (ca != cb).then(|| format!("{}: {}", rel.display(), first_difference(&ca, &cb)))
+        })
+        .collect();
+    assert!(
+        differing.is_empty(),
+        "{} of {} files differ from the uninterrupted sweep's (timing masked):\n{}",
+        differing.len(),
+        fa.len(),
+        differing.join("\n")
+    );
     fa.len()
+}
+
+/// Where two comparable contents first differ: the line of each (text), or the byte offset
+/// and the sizes (binary); the failure message quotes it, so that a rare failure in CI says
+/// what differed, not only where.
+fn first_difference(a: &[u8], b: &[u8]) -> String {
+    match (std::str::from_utf8(a), std::str::from_utf8(b)) {
+        (Ok(ta), Ok(tb)) => {
+            let (la, lb): (Vec<&str>, Vec<&str>) = (ta.lines().collect(), tb.lines().collect());
+            let i = la.iter().zip(&lb).position(|(x, y)| x != y).unwrap_or(la.len().min(lb.len()));
+            let at = |l: &[&str]| l.get(i).map_or("<end>".to_string(), |s| format!("{s:?}"));
+            format!(
+                "{} and {} lines; line {} is {} uninterrupted, {} tortured",
+                la.len(),
+                lb.len(),
+                i + 1,
+                at(&la),
+                at(&lb)
+            )
+        }
+        _ => {
+            let i = a.iter().zip(b).position(|(x, y)| x != y).unwrap_or(a.len().min(b.len()));
+            format!("{} and {} bytes, first difference at byte {i}", a.len(), b.len())
+        }
+    }
 }
 
 /// Temporary files ([`stdx::fs::is_temporary`]) anywhere under `root`.

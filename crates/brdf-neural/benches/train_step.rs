@@ -35,21 +35,7 @@
 //! against the machine's FP32 gemm rate (the `gemm` crate flex uses, all threads, into
 //! preallocated buffers, best of 11): 2048^3, and the step's dominant [n, 128] x [128, 128].
 //!
-//! Measured 2026-11-21 on the 2-core AMD EPYC (AVX-512, `x86-v4` on, 2 threads, quiet machine),
-//! burn 0.22.1 with `vendor/burn-flex` and the host-memory policy; machine gemm 206.9 GFLOP/s
-//! (2048^3), 178.4 GFLOP/s ([32768, 128] x [128, 128]). Criterion's step time in ms:
-//!
-//! | model | flex | GFLOP/s (fraction of gemm) | ndarray |
-//! | --- | ---: | ---: | ---: |
-//! | Single MLP (mapping, 114,691 params) | 164.6 | 137.2 (0.66) | 426.4 |
-//! | Enh. Add. Shared (mapping) | 259.9 | 127.2 (0.61) | 614.3 |
-//! | Disney | 179.9 | 115.6 (0.56) | 433.2 |
-//!
-//! Back to back with PyTorch 2.15 (MKL, 2 threads) in the same run, Single MLP step, medians
-//! of 10: flex 169.3 / 169.4 / 162.5 ms against PyTorch 212.8 / 214.0 / 220.5 ms, ratios 0.80,
-//! 0.79, 0.74; ndarray 1.75 to 1.89. Without the host-memory policy and the vendored patch
-//! (stock burn-flex 0.22.1, glibc defaults) the same step took 298 to 311 ms against PyTorch's
-//! 225 to 235 ms (ratio 1.3).
+//! Dated figures, the first (2026-11-21, 2-core AMD EPYC) included, are in benches/README.md.
 
 use brdf_neural::device::Backend;
 use brdf_neural::mlp::MlpConfig;
