@@ -30,7 +30,7 @@ use burn::optim::AdamConfig;
 use burn::tensor::Device;
 use indicatif::ProgressBar;
 use run_format::config::RunConfig;
-use run_format::run_dir::{RunDir, RunMetrics};
+use run_format::run_dir::{RunDir, RunMetrics, write_curve};
 use run_format::train_config::OutputInit;
 use scene::SceneDataset;
 use scene::Split;
@@ -319,6 +319,10 @@ pub fn fit_and_keep(
     } else {
         format!("step budget reached ({} steps)", state.step)
     });
+    // The curve of the last checkpoint, again: a kill between that checkpoint and its curve
+    // leaves the previous one's curve, and a run resumed from its last checkpoint trains no
+    // further step that would write it (the kill torture found such a run).
+    write_curve(&dir.curve(), &state.curve)?;
     save_weights(&model, &dir.weights())?;
     // The same weights for other tools (safetensors + JSON), before metrics.json marks the run
     // finished, so a kill in between redoes both.

@@ -254,6 +254,15 @@ fn runs_are_deterministic_and_resume_is_exact() {
         assert!(bytes(&a, rel) == bytes(&b, rel), "{rel}: two fits differ");
         assert!(bytes(&a, rel) == bytes(&r, rel), "{rel}: the resumed fit differs");
     }
+    // A kill between the last checkpoint and its curve: that checkpoint, the curve of the one
+    // before, no weights or metrics. The resume trains no step and still writes the whole curve.
+    let (full, run) = (curve(&r), RunDir::new(&r));
+    let cut: String = full.lines().take(4).map(|l| format!("{l}\n")).collect();
+    std::fs::write(run.curve(), cut).unwrap();
+    std::fs::remove_file(run.metrics()).unwrap();
+    std::fs::remove_file(run.weights()).unwrap();
+    fit(&c, &r, FitOptions::default()).unwrap();
+    assert_eq!(curve(&r), full, "the resumed run leaves the last checkpoint's curve");
     // A run directory another process works in is refused, naming that process.
     let busy = stdx::lock::DirLock::acquire(&r, "a test").unwrap();
     let msg = fit(&c, &r, FitOptions::default()).unwrap_err().to_string();
