@@ -111,21 +111,7 @@ if [ "$STAGE" = step ]; then
     run 60 step_profiled.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_BACKENDS=wgpu BRDF_BENCH_SPLIT=64 \
         $B/train_step --bench
     rm -f cubecl.toml
-    python3 - /tmp/cubecl_profile.log <<'EOF' | tee "$LOGS/kernel_profile.txt"
-import re, sys, collections
-unit = {"ns": 1e-6, "µs": 1e-3, "us": 1e-3, "ms": 1.0, "s": 1e3}
-total, count = collections.Counter(), collections.Counter()
-for line in open(sys.argv[1], errors="replace"):
-    m = re.match(r"\|\s*([0-9.]+)(ns|µs|us|ms|s)\s*\|\s*(.*)", line)
-    if m:
-        name = re.sub(r"<.*", "", m.group(3).strip())[:90]
-        total[name] += float(m.group(1)) * unit[m.group(2)]
-        count[name] += 1
-grand = sum(total.values())
-print(f"{sum(count.values())} launches, {grand:.1f} ms of kernel time in all")
-for name, ms in total.most_common(40):
-    print(f"{ms:9.2f} ms {100 * ms / grand:5.1f} % {count[name]:7d} x  {name}")
-EOF
+    python3 benches/kernel_profile.py /tmp/cubecl_profile.log | tee "$LOGS/kernel_profile.txt"
 
     step "training step on the machine's CPU cores (flex): batch split 1 and 16"
     run 90 step_cpu.log env BRDF_BENCH_QUICK=1 BRDF_BENCH_BACKENDS=flex BRDF_BENCH_SPLIT=1,16 \
@@ -383,7 +369,8 @@ if [ "$STAGE" = checks ]; then
     # MLP and FMBRDF
     # (its Lambda network dense on a GPU since 7f07314) for 1,400 steps with `nvidia-smi dmon`;
     # its warm-up table gives each model's start-up in a process after the first (fit called
-    # to first step done, the persistent GPU cache filled by the earlier processes).
+    # to first step done, the persistent GPU cache filled by the earlier processes); last, if
+    # time is left, one Single MLP and one FMBRDF step's kernels (benches/kernel_profile.py).
     # One call: DEVICE_DEADLINE=500 bash benches/device_gpu.sh checks
     export PYTHONPATH=$PWD/crates/py-neural-brdfs/python${PYTHONPATH:+:$PYTHONPATH}
     export NEURAL_BRDF_GPU_CACHE=/tmp/gpu-cache NEURAL_BRDF_GPU_LINEAR=ours
@@ -412,6 +399,15 @@ if [ "$STAGE" = checks ]; then
     DMON=$!
     run 60 loop.log $B/profile_steps /tmp/default spot__blue-acrylic 1400 wgpu SingleMlp,Fmbrdf
     kill $DMON
+    for kind in single_mlp fmbrdf; do
+        step "kernel profile of one $kind step at 2^15 (benches/kernel_profile.py)"
+        printf '[profiling.logger]\nlevel = "basic"\nfile = "/tmp/profile_%s.log"\n' "$kind" >cubecl.toml
+        run 40 "step_profiled_$kind.log" env BRDF_BENCH_QUICK=1 BRDF_BENCH_ALL_MODELS=1 \
+            BRDF_BENCH_MODELS=$kind BRDF_BENCH_BACKENDS=wgpu BRDF_BENCH_RATES=0 $B/train_step --bench
+        rm -f cubecl.toml
+        python3 benches/kernel_profile.py "/tmp/profile_$kind.log" --steps 8 |
+            tee "$LOGS/kernel_profile_$kind.txt"
+    done
 fi
 if [ "$STAGE" = cuda ]; then
     # CubeCL's CUDA runtime instead of wgpu: its kernels compiled by NVRTC (the image's CUDA
