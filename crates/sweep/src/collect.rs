@@ -102,6 +102,9 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
         let c = report::paper::compare(&paper, &observed, &rec, profile)
             .map_err(|e| Error::format(Path::new("crates/report/data/paper"), e.to_string()))?;
         let md = c.to_markdown();
+        // Each table beside the paper's on its own too (`paper-vs-ours-<table>-<data>`); they
+        // are in `paper-vs-ours.md`, so `all.md` gets them once, from there.
+        write_tables(&c.tables, out, &mut String::new(), &mut summary)?;
         write(
             SweepLayout::new(out).tables().join("paper-vs-ours.md"),
             md.as_bytes(),

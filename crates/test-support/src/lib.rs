@@ -1,5 +1,5 @@
 //! Helpers shared by the tests of every crate (taken as a dev-dependency, never by library code):
-//! where the shared dataset lives ([`shared_data_root`]), fresh temporary directories
+//! where the shared dataset and documents live ([`shared_data_root`], [`shared_docs_root`]), fresh temporary directories
 //! ([`TempDir`]), corrupted copies of real files for the loaders' robustness tests
 //! ([`corrupt`]), and adversarial directions and features for the numerics stress tests
 //! ([`adversarial`]).
@@ -9,5 +9,5 @@ pub mod corrupt;
 mod shared_data;
 mod temp_dir;
 
-pub use shared_data::shared_data_root;
+pub use shared_data::{shared_data_root, shared_docs_root};
 pub use temp_dir::TempDir;

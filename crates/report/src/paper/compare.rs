@@ -1,91 +1,171 @@
-//! Our Table 1 beside the paper's, under the paper's protocol: each cell as ours / paper / Δ,
-//! the ranking agreement per metric (Kendall's τ-b over the nine models), and the level of
-//! each group of rows against the paper's.
+//! Our tables beside the paper's: each printed cell as ours, our spread over objects, the
+//! paper's and the difference ([`beside`]); the ranking agreement per metric (Kendall's τ-b over
+//! the nine models, [`agreement`]); the level of each group of Table 1's rows against the paper's
+//! ([`level`]).
 
 use super::agreement::kendall_tau_b;
-use super::data::{ModelGroup, PaperRange, PaperTable};
-use crate::average::{average, final_records};
+use super::data::{ModelGroup, PaperTable, PaperValue, variant_name};
+use super::ours::{self, Estimate};
+use crate::average::final_records;
 use crate::record::{Dataset, Direction, MetricKind, RunOptions, RunRecord};
-use crate::result_tables::{Protocol, caption};
+use crate::result_tables::caption;
 use crate::table::{Cell, Column, ColumnGroup, Marking, Row, Table};
 use metrics::aggregate::Score;
 use model_spec::ModelKind;
 
-/// Why a paper cell is empty.
-const NOT_TRANSCRIBED: &str = "not transcribed";
+/// What our cell of a row is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Measure {
+    /// Our mean of the metric for the row's model and options (Table 1, reciprocity, energy).
+    Level,
+    /// Our difference of the row's options to the default options (the ablation tables).
+    Delta,
+}
 
-/// Our mean of `metric` for `model` on `dataset` (raw, per object then over objects); `None`
-/// when not run, not computable, or over fewer objects than the other rows (not comparable).
-pub(crate) fn ours(
-    records: &[&RunRecord],
+/// How ours and the paper's are set against each other.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Against {
+    /// Ours minus the paper's.
+    Difference,
+    /// Ours over the paper's (values across orders of magnitude: the reciprocity RMSE).
+    Ratio,
+}
+
+/// A row's label: the model, and its variant where it has one.
+pub fn row_label(model: ModelKind, options: RunOptions, table_has_variants: bool) -> String {
+    let variant = match variant_name(options) {
+        Some("none") if table_has_variants => "no strategy",
+        Some("none") | None => return model.paper_name().to_string(),
+        Some("nol") => "NOL",
+        Some("swap") => "rnd. in-swap",
+        Some("mapping") => "mapping Θ",
+        Some("albedo-clamp") => "albedo clamp",
+        Some("scalar-specular") => "scalar spec.",
+        Some(other) => other,
+    };
+    format!("{} ({variant})", model.paper_name())
+}
+
+fn ours_of(
+    last: &[&RunRecord],
+    measure: Measure,
     model: ModelKind,
+    options: RunOptions,
     d: &Dataset,
     m: MetricKind,
-) -> Option<f64> {
-    match average(records, model, RunOptions::DEFAULT, d, m) {
-        Cell::Score(Score::Value(v)) => Some(v),
-        _ => None,
+) -> Option<Estimate> {
+    match measure {
+        Measure::Level => ours::level(last, model, options, d, m),
+        Measure::Delta => ours::delta(last, model, options, d, m),
     }
 }
 
-/// The paper's table `paper` with ours beside it: per metric three columns, ours, the paper's
-/// and ours minus the paper's (raw units; the columns print them scaled as the paper does).
-pub fn side_by_side(records: &[RunRecord], paper: &PaperTable, profile: &str) -> Table {
+/// The paper's table `paper` with ours beside it: per printed column four, ours, our standard
+/// deviation over objects, the paper's, and ours against the paper's (raw units; the columns
+/// print them scaled as the paper does). The paper's DiLiGenT-MV columns take our DiLiGenT-MV
+/// runs, or our DiLiGenT runs when we have none ([`ours::stand_in`]).
+pub fn beside(
+    records: &[RunRecord],
+    paper: &PaperTable,
+    title: &str,
+    measure: Measure,
+    against: Against,
+    profile: &str,
+) -> Table {
     let last = final_records(records);
-    let d = &paper.dataset;
-    let groups = paper
-        .columns
-        .iter()
-        .map(|&m| ColumnGroup {
-            title: m.label().to_string(),
-            columns: vec![
-                Column::metric(m).labelled("ours"),
-                Column::metric(m).labelled("paper"),
-                Column { direction: Direction::Neutral, ..Column::delta(m).labelled("Δ") },
-            ],
+    let columns: Vec<(Dataset, Dataset, MetricKind)> = paper
+        .datasets()
+        .into_iter()
+        .flat_map(|d| {
+            let mine = ours::stand_in(&last, &d);
+            paper.metrics(&d).into_iter().map(move |m| (d.clone(), mine.clone(), m))
         })
         .collect();
-    let rows = ModelKind::ALL
+    let groups = columns
         .iter()
-        .map(|&model| {
-            let cells = paper
-                .columns
+        .map(|(d, mine, m)| {
+            // The data set goes into the group title only where the table has several.
+            let on = match (paper.datasets().len(), d == mine) {
+                (1, _) => String::new(),
+                (_, true) => format!(", {}", d.label()),
+                (_, false) => format!(", ours {}, paper {}", mine.label(), d.label()),
+            };
+            let first = match measure {
+                Measure::Level => Column::metric(*m),
+                Measure::Delta => Column::delta(*m),
+            };
+            let neutral = |c: Column| Column { direction: Direction::Neutral, ..c };
+            let compared = match against {
+                Against::Difference => neutral(Column::delta(*m).labelled("ours − paper")),
+                Against::Ratio => Column {
+                    factor: 1.0,
+                    decimals: 2,
+                    signed: false,
+                    ..neutral(Column::metric(*m).labelled("ours / paper"))
+                },
+            };
+            ColumnGroup {
+                title: format!("{}{on}", m.label()),
+                columns: vec![
+                    first.clone().labelled("ours"),
+                    neutral(Column { signed: false, ..first.clone() }.labelled("± (objects)")),
+                    first.labelled("paper"),
+                    compared,
+                ],
+            }
+        })
+        .collect();
+    let rows_of = paper.rows();
+    let has_variants = rows_of.iter().any(|r| r.1 != RunOptions::DEFAULT);
+    let rows = rows_of
+        .iter()
+        .map(|&(model, options)| {
+            let cells = columns
                 .iter()
-                .flat_map(|&m| {
-                    let ours = ours(&last, model, d, m);
-                    let theirs = paper.value(model, None, m).map(|v| v / m.factor());
-                    // A mean over fewer objects than the others' shows with its dagger and
-                    // gets no difference.
-                    let mine = average(&last, model, RunOptions::DEFAULT, d, m);
-                    let theirs_cell = theirs.map_or_else(
-                        || Cell::Score(Score::Unavailable(NOT_TRANSCRIBED.into())),
-                        Cell::value,
-                    );
-                    let delta = match (ours, theirs) {
-                        (Some(a), Some(b)) => Cell::value(a - b),
-                        (None, _) => Cell::NotRun,
-                        (_, None) => Cell::Score(Score::Unavailable(NOT_TRANSCRIBED.into())),
+                .flat_map(|(d, mine, m)| {
+                    let printed = paper.cells.iter().find(|(k, _)| {
+                        &k.dataset == d
+                            && k.model == model
+                            && k.options == options
+                            && k.metric == *m
+                    });
+                    // A cell of one object (the figure's renders) sets ours on that object.
+                    let object = printed.and_then(|c| c.0.object.as_deref());
+                    let on: Vec<&RunRecord> = match object {
+                        Some(o) => last.iter().copied().filter(|r| r.object == o).collect(),
+                        None => last.clone(),
                     };
-                    [mine, theirs_cell, delta]
+                    let e = ours_of(&on, measure, model, options, mine, *m);
+                    let theirs = match printed.map(|c| c.1) {
+                        Some(PaperValue::Printed(v)) => Ok(v / m.factor()),
+                        Some(PaperValue::NoNumber) => Err("the paper prints a word (all valid)"),
+                        _ => Err("not transcribed"),
+                    };
+                    comparison_cells(e.as_ref(), theirs, against)
                 })
                 .collect();
-            Row::new(model.paper_name(), cells)
+            Row::new(row_label(model, options, has_variants), cells)
         })
         .collect();
+    let datasets: Vec<Dataset> = columns.iter().map(|c| c.1.clone()).collect();
+    let mut datasets_unique = datasets.clone();
+    datasets_unique.dedup();
+    let what = match measure {
+        Measure::Level => "ours",
+        Measure::Delta => "our difference to the default options (paired per object)",
+    };
+    let text = format!(
+        "{title}, beside the paper ({}, {}). Per printed column: {what}; our standard deviation \
+         over objects (a difference within about two standard errors, ± / √objects, is within \
+         our noise); the paper's value as printed; ours {} the paper's. DSSIM, LPIPS, FLIP and \
+         RMSE∛ ×100. Ours are averaged per object, then over this profile's objects; the paper \
+         averages 25 materials on 9 meshes (MERL) or 5 objects (DiLiGenT-MV).",
+        paper.label,
+        paper.file,
+        if against == Against::Ratio { "over" } else { "minus" },
+    );
     Table {
-        caption: caption(
-            &format!(
-                "Ours beside the paper's Table 1 ({}, {}). {} Per metric: ours, the paper's \
-                 value as printed, and ours minus the paper's; DSSIM, LPIPS, FLIP and RMSE∛ \
-                 ×100. Ours are averaged per object, then over this profile's objects; the \
-                 paper averages 25 materials on 9 meshes (MERL) or 5 objects (DiLiGenT-MV).",
-                d.label(),
-                paper.file,
-                Protocol::Paper.caption()
-            ),
-            std::slice::from_ref(d),
-            profile,
-        ),
+        caption: caption(&text, &datasets_unique, profile),
         stub_header: "Model".into(),
         groups,
         rows,
@@ -94,9 +174,39 @@ pub fn side_by_side(records: &[RunRecord], paper: &PaperTable, profile: &str) ->
     }
 }
 
+/// Ours, our spread, the paper's and the comparison of one column.
+fn comparison_cells(
+    e: Option<&Estimate>,
+    theirs: Result<f64, &str>,
+    against: Against,
+) -> [Cell; 4] {
+    let unavailable = |why: &str| Cell::Score(Score::Unavailable(why.into()));
+    let mine = e.map_or(Cell::NotRun, |e| Cell::value(e.mean));
+    let spread = match e {
+        None => Cell::NotRun,
+        Some(Estimate { sd: Some(sd), .. }) => Cell::value(*sd),
+        Some(_) => unavailable("one object: no spread"),
+    };
+    let paper = theirs.map_or_else(unavailable, Cell::value);
+    let compared = match (e, theirs) {
+        (None, _) => Cell::NotRun,
+        (_, Err(why)) => unavailable(why),
+        (Some(e), Ok(t)) => match against {
+            Against::Difference => Cell::value(e.mean - t),
+            Against::Ratio if t != 0.0 => Cell::value(e.mean / t),
+            Against::Ratio => unavailable("the paper's value is 0"),
+        },
+    };
+    [mine, spread, paper, compared]
+}
+
 /// The ranking agreement of one metric.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Agreement {
+    /// The paper's data set.
+    pub dataset: Dataset,
+    /// Ours beside it.
+    pub ours: Dataset,
     /// The metric.
     pub metric: MetricKind,
     /// Kendall's τ-b over the models with both values; `None` when fewer than two.
@@ -105,49 +215,58 @@ pub struct Agreement {
     pub models: usize,
 }
 
-/// Kendall's τ-b between our and the paper's values of every column of `paper`, over the
-/// models with both.
+/// Kendall's τ-b between our and the paper's values of every column of `paper` (Table 1), over
+/// the models with both.
 pub fn agreement(records: &[RunRecord], paper: &PaperTable) -> Vec<Agreement> {
     let last = final_records(records);
-    paper
-        .columns
-        .iter()
-        .map(|&metric| {
+    let mut out = Vec::new();
+    for d in paper.datasets() {
+        let mine = ours::stand_in(&last, &d);
+        for metric in paper.metrics(&d) {
             let (mut a, mut b) = (Vec::new(), Vec::new());
             for model in ModelKind::ALL {
-                let theirs = paper.value(model, None, metric).map(|v| v / metric.factor());
-                if let (Some(x), Some(y)) = (ours(&last, model, &paper.dataset, metric), theirs) {
-                    a.push(x);
+                let theirs = paper.value(&d, model, RunOptions::DEFAULT, None, metric);
+                let e = ours::level(&last, model, RunOptions::DEFAULT, &mine, metric);
+                if let (Some(x), Some(y)) = (e, theirs) {
+                    a.push(x.mean);
                     b.push(y);
                 }
             }
-            Agreement { metric, tau: kendall_tau_b(&a, &b), models: a.len() }
-        })
-        .collect()
+            let tau = kendall_tau_b(&a, &b);
+            out.push(Agreement {
+                dataset: d.clone(),
+                ours: mine.clone(),
+                metric,
+                tau,
+                models: a.len(),
+            });
+        }
+    }
+    out
 }
 
 /// Whether our level of a group of rows matches the paper's.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Verdict {
-    /// Within the tolerance of the paper's group mean, for certain.
+    /// Within the tolerance of the paper's group mean.
     Within,
-    /// Within the tolerance of the paper's range, but the paper's mean is not known well
-    /// enough to decide.
-    Undecided,
-    /// Further than the tolerance from any value the paper's mean can take.
+    /// Further than the tolerance.
     Outside,
     /// We have no runs of the group on the data set.
     NotRun,
 }
 
-/// Our mean of one column over a group of rows against the paper's.
+/// Our mean of one column over a group of Table 1's rows against the paper's.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LevelCheck {
-    /// The paper's range (or the group's transcribed values, when complete).
-    pub range: PaperRange,
-    /// Whether the paper's mean is known exactly (every cell of the group transcribed): then
-    /// `range.min == range.max` is that mean.
-    pub exact: bool,
+    /// The data set.
+    pub dataset: Dataset,
+    /// The rows.
+    pub group: ModelGroup,
+    /// The column.
+    pub metric: MetricKind,
+    /// The paper's printed values of the group: (smallest, largest, mean).
+    pub paper: (f64, f64, f64),
     /// Our per-model means, (model, value), printed scale.
     pub ours: Vec<(ModelKind, f64)>,
     /// The tolerance, printed units.
@@ -173,53 +292,44 @@ pub fn tolerance(group: ModelGroup) -> f64 {
     }
 }
 
-/// Our level of each quoted range's group against the paper's. When `paper` holds every cell
-/// of the group, its mean replaces the range.
-pub fn level(records: &[RunRecord], ranges: &[PaperRange], paper: &PaperTable) -> Vec<LevelCheck> {
+/// Our PSNR level of each group of rows on the paper's MERL half of Table 1 against the
+/// paper's group mean.
+pub fn level(records: &[RunRecord], paper: &PaperTable) -> Vec<LevelCheck> {
     let last = final_records(records);
-    ranges
-        .iter()
-        .map(|r| {
-            let models = r.group.models();
+    let d = Dataset::MerlNbrdf;
+    let metric = MetricKind::Psnr;
+    [ModelGroup::PurelyNeural, ModelGroup::Parametric]
+        .into_iter()
+        .map(|group| {
+            let models = group.models();
+            let printed: Vec<f64> = models
+                .iter()
+                .filter_map(|&m| paper.value(&d, m, RunOptions::DEFAULT, None, metric))
+                .collect();
+            let lo = printed.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = printed.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let mean = printed.iter().sum::<f64>() / printed.len().max(1) as f64;
             let ours: Vec<(ModelKind, f64)> = models
                 .iter()
                 .filter_map(|&m| {
-                    ours(&last, m, &r.dataset, r.metric).map(|v| (m, v * r.metric.factor()))
+                    ours::level(&last, m, RunOptions::DEFAULT, &d, metric)
+                        .map(|e| (m, e.mean * metric.factor()))
                 })
                 .collect();
-            let printed: Vec<f64> = if paper.dataset == r.dataset {
-                models.iter().filter_map(|&m| paper.value(m, None, r.metric)).collect()
-            } else {
-                vec![]
+            let tolerance = tolerance(group);
+            let mut check = LevelCheck {
+                dataset: d.clone(),
+                group,
+                metric,
+                paper: (lo, hi, mean),
+                ours,
+                tolerance,
+                verdict: Verdict::NotRun,
             };
-            let mut range = r.clone();
-            let exact = printed.len() == models.len();
-            if exact {
-                let mean = printed.iter().sum::<f64>() / printed.len() as f64;
-                (range.min, range.max) = (mean, mean);
-            }
-            let tolerance = tolerance(r.group);
-            let mut check = LevelCheck { range, exact, ours, tolerance, verdict: Verdict::NotRun };
             check.verdict = match check.our_mean() {
                 None => Verdict::NotRun,
-                Some(m) => {
-                    let (lo, hi) = (check.range.min, check.range.max);
-                    let worst = (m - lo).abs().max((m - hi).abs());
-                    let nearest = if m < lo {
-                        lo - m
-                    } else if m > hi {
-                        m - hi
-                    } else {
-                        0.0
-                    };
-                    if worst <= tolerance {
-                        Verdict::Within
-                    } else if nearest <= tolerance {
-                        Verdict::Undecided
-                    } else {
-                        Verdict::Outside
-                    }
-                }
+                Some(m) if (m - mean).abs() <= tolerance => Verdict::Within,
+                Some(_) => Verdict::Outside,
             };
             check
         })
@@ -228,23 +338,27 @@ pub fn level(records: &[RunRecord], ranges: &[PaperRange], paper: &PaperTable) -
 
 #[cfg(test)]
 mod tests {
-    use super::super::data::PaperRow;
+    use super::super::data::{self, CellKey};
     use super::*;
 
     fn paper_with(values: &[(ModelKind, f64)]) -> PaperTable {
-        PaperTable {
-            file: "test.csv",
-            dataset: Dataset::MerlNbrdf,
-            columns: vec![MetricKind::Psnr, MetricKind::Dssim],
-            rows: ModelKind::ALL
-                .iter()
-                .map(|&m| PaperRow {
-                    object: None,
-                    model: m,
-                    values: vec![values.iter().find(|v| v.0 == m).map(|v| v.1), None],
+        let cells = ModelKind::ALL
+            .iter()
+            .flat_map(|&m| {
+                [MetricKind::Psnr, MetricKind::Dssim].map(|metric| {
+                    let v = values.iter().find(|v| v.0 == m && metric == MetricKind::Psnr);
+                    let key = CellKey {
+                        dataset: Dataset::MerlNbrdf,
+                        object: None,
+                        model: m,
+                        options: RunOptions::DEFAULT,
+                        metric,
+                    };
+                    (key, v.map_or(PaperValue::NotTranscribed, |v| PaperValue::Printed(v.1)))
                 })
-                .collect(),
-        }
+            })
+            .collect();
+        PaperTable { file: "test.csv", label: "tab:test", cells }
     }
 
     fn ours_psnr(values: &[(ModelKind, &str, f64)]) -> Vec<RunRecord> {
@@ -257,27 +371,41 @@ mod tests {
     }
 
     #[test]
-    fn cells_are_ours_paper_and_the_difference() {
+    fn cells_are_ours_spread_paper_and_the_difference() {
         let paper = paper_with(&[(ModelKind::Rp, 44.0), (ModelKind::SingleMlp, 52.0)]);
         let ours = ours_psnr(&[
             (ModelKind::Rp, "a", 40.0),
             (ModelKind::Rp, "b", 42.0),
             (ModelKind::Ts, "a", 43.0),
         ]);
-        let t = side_by_side(&ours, &paper, "default");
-        assert_eq!(t.columns().len(), 6);
-        assert_eq!(
-            (t.cell_text(0, 0), t.cell_text(0, 1), t.cell_text(0, 2)),
-            ("41.00".into(), "44.00".into(), "-3.00".into())
-        );
-        // TS: ours only, on one of the two objects (a partial mean, no difference); the
-        // paper's cell is not transcribed.
-        assert_eq!(t.cell_text(1, 0), "43.00†");
-        assert_eq!(t.cell_text(1, 2), "–");
-        assert_eq!(t.cell_text(1, 1), "n/a");
+        let t = beside(&ours, &paper, "Table 1", Measure::Level, Against::Difference, "default");
+        assert_eq!(t.columns().len(), 8);
+        let row: Vec<String> = (0..4).map(|c| t.cell_text(0, c)).collect();
+        assert_eq!(row, ["41.00", "1.41", "44.00", "-3.00"]);
+        // TS: on one of the two objects, not comparable; the paper's cell is not transcribed.
+        assert_eq!((t.cell_text(1, 0), t.cell_text(1, 2)), ("–".into(), "n/a".into()));
         // Single MLP: the paper's only.
-        assert_eq!((t.cell_text(4, 0), t.cell_text(4, 1)), ("–".into(), "52.00".into()));
-        assert!(t.caption.contains("The paper's protocol"), "{}", t.caption);
+        assert_eq!((t.cell_text(4, 0), t.cell_text(4, 2)), ("–".into(), "52.00".into()));
+        assert!(t.caption.contains("tab:test"), "{}", t.caption);
+    }
+
+    #[test]
+    fn ablation_rows_are_paired_deltas_beside_the_papers() {
+        let nol = RunOptions { nol: true, ..RunOptions::DEFAULT };
+        let mut records = Vec::new();
+        for (o, base, var) in [("a", 50.0, 49.0), ("b", 52.0, 51.5)] {
+            let r = RunRecord::new(ModelKind::SingleMlp, Dataset::MerlNbrdf, o);
+            records.push(r.clone().with_value(MetricKind::Psnr, base));
+            records.push(r.with_options(nol).with_value(MetricKind::Psnr, var));
+        }
+        let paper = data::table("nol.csv").unwrap();
+        let t = beside(&records, &paper, "NOL", Measure::Delta, Against::Difference, "default");
+        assert_eq!(t.rows.len(), 3);
+        assert_eq!(t.rows[0].label, "Single MLP (NOL)");
+        // Columns: MERL RMSE∛ (4), then PSNR: ours -0.75, spread 0.35, paper -0.15, -0.60.
+        let psnr: Vec<String> = (4..8).map(|c| t.cell_text(0, c)).collect();
+        assert_eq!(psnr, ["-0.75", "0.35", "-0.15", "-0.60"]);
+        assert_eq!(t.cell_text(1, 4), "–");
     }
 
     #[test]
@@ -299,29 +427,17 @@ mod tests {
     }
 
     #[test]
-    fn level_checks_a_range_and_an_exact_mean() {
-        let range = |min, max| PaperRange {
-            dataset: Dataset::MerlNbrdf,
-            group: ModelGroup::PurelyNeural,
-            metric: MetricKind::Psnr,
-            min,
-            max,
-            source: "test".into(),
+    fn level_against_the_papers_group_mean() {
+        let paper = data::table1().unwrap();
+        let at = |v: f64| {
+            let neural: Vec<(ModelKind, &str, f64)> =
+                ModelGroup::PurelyNeural.models().into_iter().map(|m| (m, "a", v)).collect();
+            level(&ours_psnr(&neural), &paper)[0].clone()
         };
-        let neural: Vec<(ModelKind, &str, f64)> =
-            ModelGroup::PurelyNeural.models().into_iter().map(|m| (m, "a", 51.0)).collect();
-        let ours = ours_psnr(&neural);
-        let empty = paper_with(&[]);
-        let v = |min, max| level(&ours, &[range(min, max)], &empty)[0].verdict.clone();
-        assert_eq!(v(51.4, 52.4), Verdict::Within);
-        assert_eq!(v(51.4, 53.0), Verdict::Undecided);
-        assert_eq!(v(53.0, 54.0), Verdict::Outside);
-        // Every neural cell transcribed: their mean (53.0) decides.
-        let all: Vec<(ModelKind, f64)> =
-            ModelGroup::PurelyNeural.models().into_iter().map(|m| (m, 53.0)).collect();
-        let c = &level(&ours, &[range(40.0, 60.0)], &paper_with(&all))[0];
-        assert!(c.exact && c.range.min == 53.0);
-        assert_eq!(c.verdict, Verdict::Outside);
-        assert_eq!(level(&[], &[range(1.0, 2.0)], &empty)[0].verdict, Verdict::NotRun);
+        let c = at(52.0);
+        assert_eq!(c.verdict, Verdict::Within);
+        assert!((c.paper.2 - 52.074).abs() < 1e-9, "{:?}", c.paper);
+        assert_eq!(at(54.0).verdict, Verdict::Outside);
+        assert_eq!(level(&[], &paper)[1].verdict, Verdict::NotRun);
     }
 }

@@ -1,54 +1,130 @@
 //! The paper's published values, compiled in from `crates/report/data/paper/` (see its
-//! README): Table 1's MERL and DiLiGenT-MV halves, the supplement's per-object DiLiGenT-MV
-//! table, and the ranges of Table 1 known second-hand. Values are kept as printed (PSNR in dB,
-//! the other image metrics and RMSE∛ ×100); an empty cell is a value not transcribed.
+//! README): every table of the paper and the per-render PSNRs of its figure
+//! `fig:evaluation_renderings`. Values are kept as printed (PSNR in dB, the other image metrics
+//! and RMSE∛ ×100, the reciprocity RMSE unscaled, the energy share in %).
+//!
+//! A file is a header and one line a row. The header's first fields are lead columns, in this
+//! order and each optional but `model`: `dataset`, `object`, `model`, `variant`; then one field
+//! a printed column, `DATASET:METRIC` (`merl:PSNR`) or, in a file with a `dataset` lead column,
+//! `METRIC`. A variant is one of [`VARIANTS`]. A cell is a number, `-` where the paper prints a
+//! word instead ("all valid": no energy above 1 to take a median of), or empty where not
+//! transcribed.
 
-use crate::record::{Dataset, MetricKind};
-use model_spec::ModelKind;
+use crate::record::{Dataset, MetricKind, RunOptions};
+use model_spec::{AngleParametrization, ModelKind, Reciprocity};
 
-/// One of the paper's tables.
+/// A printed cell of one of the paper's tables.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PaperValue {
+    /// A number, as printed.
+    Printed(f64),
+    /// The paper prints a word, no number ("all valid").
+    NoNumber,
+    /// Not transcribed.
+    NotTranscribed,
+}
+
+/// Where a cell sits: the data set, object, model, options and metric it reports.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CellKey {
+    /// The data set of its column.
+    pub dataset: Dataset,
+    /// The object (per-object tables and the figure only).
+    pub object: Option<String>,
+    /// The model of its row.
+    pub model: ModelKind,
+    /// The variant of its row (the default options in Table 1 and the energy table).
+    pub options: RunOptions,
+    /// The metric of its column.
+    pub metric: MetricKind,
+}
+
+/// One of the paper's tables, flattened to its cells in the file's order (row by row).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PaperTable {
     /// The data file it came from (for errors and captions).
     pub file: &'static str,
-    /// The data set of its rows.
-    pub dataset: Dataset,
-    /// Its metric columns, in the paper's order.
-    pub columns: Vec<MetricKind>,
-    /// Its rows, in the paper's order.
-    pub rows: Vec<PaperRow>,
-}
-
-/// A row of a paper table: a model (and, per object, its object) and one value a column.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PaperRow {
-    /// The object (per-object tables only).
-    pub object: Option<String>,
-    /// The model.
-    pub model: ModelKind,
-    /// The printed values, `None` where not transcribed.
-    pub values: Vec<Option<f64>>,
+    /// The LaTeX label of the table (or figure) it transcribes.
+    pub label: &'static str,
+    /// Its cells.
+    pub cells: Vec<(CellKey, PaperValue)>,
 }
 
 impl PaperTable {
-    /// The printed value of `metric` for `model` (on `object` in a per-object table).
-    pub fn value(&self, model: ModelKind, object: Option<&str>, metric: MetricKind) -> Option<f64> {
-        let c = self.columns.iter().position(|&m| m == metric)?;
-        self.rows
-            .iter()
-            .find(|r| r.model == model && r.object.as_deref() == object)
-            .and_then(|r| r.values[c])
+    /// The printed value of `metric` for `model` with `options` on `dataset` (on `object` in a
+    /// per-object table), if the paper prints a number there.
+    pub fn value(
+        &self,
+        dataset: &Dataset,
+        model: ModelKind,
+        options: RunOptions,
+        object: Option<&str>,
+        metric: MetricKind,
+    ) -> Option<f64> {
+        self.cells.iter().find_map(|(k, v)| match v {
+            PaperValue::Printed(x)
+                if &k.dataset == dataset
+                    && k.model == model
+                    && k.options == options
+                    && k.object.as_deref() == object
+                    && k.metric == metric =>
+            {
+                Some(*x)
+            }
+            _ => None,
+        })
     }
 
-    /// How many cells hold a value.
+    /// The data sets of its columns, in the file's order.
+    pub fn datasets(&self) -> Vec<Dataset> {
+        unique(self.cells.iter().map(|(k, _)| k.dataset.clone()))
+    }
+
+    /// The metrics printed for `dataset`, in the file's order.
+    pub fn metrics(&self, dataset: &Dataset) -> Vec<MetricKind> {
+        unique(self.cells.iter().filter(|(k, _)| &k.dataset == dataset).map(|(k, _)| k.metric))
+    }
+
+    /// The rows: (model, options), in the file's order.
+    pub fn rows(&self) -> Vec<(ModelKind, RunOptions)> {
+        unique(self.cells.iter().map(|(k, _)| (k.model, k.options)))
+    }
+
+    /// The objects of a per-object table, in the file's order.
+    pub fn objects(&self) -> Vec<String> {
+        unique(self.cells.iter().filter_map(|(k, _)| k.object.clone()))
+    }
+
+    /// The table restricted to the columns of `dataset`.
+    pub fn only(&self, dataset: &Dataset) -> PaperTable {
+        let cells = self.cells.iter().filter(|(k, _)| &k.dataset == dataset).cloned().collect();
+        PaperTable { cells, ..self.clone() }
+    }
+
+    /// How many cells are transcribed (a number or a printed word).
     pub fn transcribed(&self) -> usize {
-        self.rows.iter().map(|r| r.values.iter().flatten().count()).sum()
+        self.cells.iter().filter(|(_, v)| *v != PaperValue::NotTranscribed).count()
     }
 
     /// How many cells the table has.
-    pub fn cells(&self) -> usize {
-        self.rows.len() * self.columns.len()
+    pub fn len(&self) -> usize {
+        self.cells.len()
     }
+
+    /// Whether the table has no cell.
+    pub fn is_empty(&self) -> bool {
+        self.cells.is_empty()
+    }
+}
+
+fn unique<T: PartialEq>(items: impl Iterator<Item = T>) -> Vec<T> {
+    let mut out: Vec<T> = Vec::new();
+    for x in items {
+        if !out.contains(&x) {
+            out.push(x);
+        }
+    }
+    out
 }
 
 /// A group of Table 1's rows.
@@ -71,30 +147,13 @@ impl ModelGroup {
         ModelKind::ALL.into_iter().filter(|&m| ModelGroup::of(m) == self).collect()
     }
 
-    /// The group's name as the data files and the comparison write it.
+    /// The group's name as the comparison writes it.
     pub fn label(self) -> &'static str {
         match self {
             ModelGroup::Parametric => "parametric",
             ModelGroup::PurelyNeural => "purely neural",
         }
     }
-}
-
-/// The range of one column over a group of the paper's rows, as printed.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PaperRange {
-    /// The data set.
-    pub dataset: Dataset,
-    /// The rows.
-    pub group: ModelGroup,
-    /// The column.
-    pub metric: MetricKind,
-    /// The smallest printed value of the group.
-    pub min: f64,
-    /// The largest.
-    pub max: f64,
-    /// Where the range is quoted from.
-    pub source: String,
 }
 
 /// An error in a compiled-in data file: the file, the line (1-based) and the fault.
@@ -109,55 +168,81 @@ pub struct DataError {
     pub fault: String,
 }
 
-const TABLE1_MERL: (&str, &str) =
-    ("table1-merl.csv", include_str!("../../data/paper/table1-merl.csv"));
-const TABLE1_DILIGENT_MV: (&str, &str) =
-    ("table1-diligent-mv.csv", include_str!("../../data/paper/table1-diligent-mv.csv"));
-const PER_OBJECT_DILIGENT_MV: (&str, &str) =
-    ("per-object-diligent-mv.csv", include_str!("../../data/paper/per-object-diligent-mv.csv"));
-const RANGES: (&str, &str) = ("ranges.csv", include_str!("../../data/paper/ranges.csv"));
+/// The variants of the ablation tables' rows, as the data files name them, with their options.
+pub const VARIANTS: [(&str, RunOptions); 7] = [
+    ("none", RunOptions::DEFAULT),
+    ("nol", RunOptions { nol: true, ..RunOptions::DEFAULT }),
+    ("swap", RunOptions { reciprocity: Reciprocity::RandomSwap, ..RunOptions::DEFAULT }),
+    ("mapping", RunOptions { reciprocity: Reciprocity::Mapping, ..RunOptions::DEFAULT }),
+    (
+        "view-light",
+        RunOptions { parametrization: AngleParametrization::ViewLight, ..RunOptions::DEFAULT },
+    ),
+    ("albedo-clamp", RunOptions { albedo_clamp: true, ..RunOptions::DEFAULT }),
+    ("scalar-specular", RunOptions { scalar_specular: true, ..RunOptions::DEFAULT }),
+];
 
-/// Table 1, MERL half: 9 models x PSNR, DSSIM, LPIPS, FLIP, RMSE∛.
-pub fn table1_merl() -> Result<PaperTable, DataError> {
-    parse_table(TABLE1_MERL, Dataset::MerlNbrdf, false)
+/// The name of `options` in [`VARIANTS`], if it is one of them.
+pub fn variant_name(options: RunOptions) -> Option<&'static str> {
+    VARIANTS.iter().find(|(_, o)| *o == options).map(|(n, _)| *n)
 }
 
-/// Table 1, DiLiGenT-MV half: 9 models x PSNR, DSSIM, LPIPS, FLIP.
-pub fn table1_diligent_mv() -> Result<PaperTable, DataError> {
-    parse_table(TABLE1_DILIGENT_MV, Dataset::DiligentMv, false)
+/// Every data file: (file, the label it transcribes, its text).
+pub const FILES: [(&str, &str, &str); 9] = [
+    ("table1.csv", "tab:quantitative", include_str!("../../data/paper/table1.csv")),
+    (
+        "per-object-diligent-mv.csv",
+        "tab:supp:diligent_quantitative",
+        include_str!("../../data/paper/per-object-diligent-mv.csv"),
+    ),
+    ("nol.csv", "tab:changes_quantitative_NOL", include_str!("../../data/paper/nol.csv")),
+    (
+        "reciprocity-rmse.csv",
+        "tab:reciprocity",
+        include_str!("../../data/paper/reciprocity-rmse.csv"),
+    ),
+    ("energy.csv", "tab:energy", include_str!("../../data/paper/energy.csv")),
+    (
+        "reciprocity-quality.csv",
+        "tab:changes_quantitative_reci",
+        include_str!("../../data/paper/reciprocity-quality.csv"),
+    ),
+    (
+        "view-light.csv",
+        "tab:changes_quantitative_view_light",
+        include_str!("../../data/paper/view-light.csv"),
+    ),
+    (
+        "nerfactor.csv",
+        "tab:supp:changes_quantitative_nerfactor",
+        include_str!("../../data/paper/nerfactor.csv"),
+    ),
+    (
+        "evaluation-renderings.csv",
+        "fig:evaluation_renderings",
+        include_str!("../../data/paper/evaluation-renderings.csv"),
+    ),
+];
+
+/// The table of `file` (one of [`FILES`]).
+pub fn table(file: &str) -> Result<PaperTable, DataError> {
+    let &(file, label, text) = FILES.iter().find(|f| f.0 == file).ok_or(DataError {
+        file: "README.md",
+        line: 0,
+        fault: format!("no data file {file}"),
+    })?;
+    parse(file, label, text)
 }
 
-/// The supplement's DiLiGenT-MV table: 5 objects x 9 models x PSNR, DSSIM, LPIPS, FLIP.
-pub fn per_object_diligent_mv() -> Result<PaperTable, DataError> {
-    parse_table(PER_OBJECT_DILIGENT_MV, Dataset::DiligentMv, true)
+/// Every table of [`FILES`].
+pub fn all_tables() -> Result<Vec<PaperTable>, DataError> {
+    FILES.iter().map(|&(f, l, t)| parse(f, l, t)).collect()
 }
 
-/// The ranges of Table 1 known second-hand (see the data README).
-pub fn ranges() -> Result<Vec<PaperRange>, DataError> {
-    let (file, text) = RANGES;
-    let err = |line: usize, fault: String| DataError { file, line, fault };
-    let mut out = Vec::new();
-    for (i, line) in text.lines().enumerate().skip(1).filter(|(_, l)| !l.trim().is_empty()) {
-        let f: Vec<&str> = line.split(',').map(str::trim).collect();
-        let [dataset, rows, metric, min, max, source] = f[..] else {
-            return Err(err(i + 1, format!("{} fields, expected 6", f.len())));
-        };
-        let group = match rows {
-            "parametric" => ModelGroup::Parametric,
-            "purely neural" => ModelGroup::PurelyNeural,
-            other => return Err(err(i + 1, format!("unknown rows {other:?}"))),
-        };
-        let number = |s: &str| s.parse::<f64>().map_err(|e| err(i + 1, format!("{s:?}: {e}")));
-        out.push(PaperRange {
-            dataset: Dataset::from_label(dataset),
-            group,
-            metric: metric_of(metric).ok_or_else(|| err(i + 1, format!("metric {metric:?}")))?,
-            min: number(min)?,
-            max: number(max)?,
-            source: source.to_string(),
-        });
-    }
-    Ok(out)
+/// Table 1, both halves: 9 models x (MERL: RMSE∛, PSNR, DSSIM, LPIPS, FLIP; DiLiGenT-MV: PSNR,
+/// DSSIM, LPIPS, FLIP).
+pub fn table1() -> Result<PaperTable, DataError> {
+    table("table1.csv")
 }
 
 fn metric_of(label: &str) -> Option<MetricKind> {
@@ -168,117 +253,173 @@ fn model_of(name: &str) -> Option<ModelKind> {
     ModelKind::ALL.into_iter().find(|m| m.paper_name() == name)
 }
 
-/// A table file: a header `[object,]model,<metric labels>` and one row a line.
-fn parse_table(
-    (file, text): (&'static str, &str),
-    dataset: Dataset,
-    per_object: bool,
-) -> Result<PaperTable, DataError> {
+fn dataset_of(name: &str) -> Option<Dataset> {
+    match Dataset::from_label(name) {
+        Dataset::Other(_) => None,
+        d => Some(d),
+    }
+}
+
+/// The lead columns a header may start with, in their order.
+const LEADS: [&str; 4] = ["dataset", "object", "model", "variant"];
+
+/// A file's text as a table (see the module's documentation for the format).
+pub fn parse(file: &'static str, label: &'static str, text: &str) -> Result<PaperTable, DataError> {
     let err = |line: usize, fault: String| DataError { file, line, fault };
     let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
     let (_, header) = lines.next().ok_or_else(|| err(1, "empty file".into()))?;
-    let lead = if per_object { 2 } else { 1 };
     let names: Vec<&str> = header.split(',').map(str::trim).collect();
-    let expected = if per_object { ["object", "model"].as_slice() } else { ["model"].as_slice() };
-    if names.len() <= lead || names[..lead] != *expected {
-        return Err(err(1, format!("header {header:?} must start with {}", expected.join(","))));
+    let mut leads = Vec::new();
+    for lead in LEADS {
+        if names.get(leads.len()) == Some(&lead) {
+            leads.push(lead);
+        }
     }
-    let columns = names[lead..]
+    if !leads.contains(&"model") {
+        return Err(err(1, format!("header {header:?} has no model column")));
+    }
+    let has_dataset = leads.contains(&"dataset");
+    let columns = names[leads.len()..]
         .iter()
-        .map(|n| metric_of(n).ok_or_else(|| err(1, format!("unknown column {n:?}"))))
+        .map(|n| {
+            let (dataset, metric) = match n.split_once(':') {
+                Some((d, m)) => {
+                    let d =
+                        dataset_of(d).ok_or_else(|| err(1, format!("unknown data set {d:?}")))?;
+                    (Some(d), m)
+                }
+                None if has_dataset => (None, *n),
+                None => return Err(err(1, format!("column {n:?} names no data set (merl:{n}?)"))),
+            };
+            let metric =
+                metric_of(metric).ok_or_else(|| err(1, format!("unknown column {n:?}")))?;
+            Ok((dataset, metric))
+        })
         .collect::<Result<Vec<_>, _>>()?;
-    let mut rows = Vec::new();
+    if columns.is_empty() {
+        return Err(err(1, format!("header {header:?} has no value column")));
+    }
+    let mut cells = Vec::new();
     for (i, line) in lines {
         let f: Vec<&str> = line.split(',').map(str::trim).collect();
         if f.len() != names.len() {
             return Err(err(i + 1, format!("{} fields, the header has {}", f.len(), names.len())));
         }
-        let model = model_of(f[lead - 1])
-            .ok_or_else(|| err(i + 1, format!("unknown model {:?}", f[lead - 1])))?;
-        let values = f[lead..]
-            .iter()
-            .map(|v| match *v {
-                "" => Ok(None),
+        let lead = |name: &str| leads.iter().position(|l| *l == name).map(|p| f[p]);
+        let model = lead("model").unwrap_or_default();
+        let model =
+            model_of(model).ok_or_else(|| err(i + 1, format!("unknown model {model:?}")))?;
+        let options = match lead("variant") {
+            None => RunOptions::DEFAULT,
+            Some(v) => VARIANTS
+                .iter()
+                .find(|(n, _)| *n == v)
+                .map(|(_, o)| *o)
+                .ok_or_else(|| err(i + 1, format!("unknown variant {v:?}")))?,
+        };
+        let row_dataset = match lead("dataset") {
+            None => None,
+            Some(d) => {
+                Some(dataset_of(d).ok_or_else(|| err(i + 1, format!("unknown data set {d:?}")))?)
+            }
+        };
+        let object = lead("object").map(str::to_string);
+        for ((dataset, metric), v) in columns.iter().zip(&f[leads.len()..]) {
+            let value = match *v {
+                "" => PaperValue::NotTranscribed,
+                "-" => PaperValue::NoNumber,
                 v => v
                     .parse::<f64>()
                     .ok()
                     .filter(|x| x.is_finite())
-                    .map(Some)
-                    .ok_or_else(|| err(i + 1, format!("{v:?} is not a number"))),
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let object = per_object.then(|| f[0].to_string());
-        rows.push(PaperRow { object, model, values });
+                    .map(PaperValue::Printed)
+                    .ok_or_else(|| err(i + 1, format!("{v:?} is not a number")))?,
+            };
+            let dataset =
+                dataset.clone().or_else(|| row_dataset.clone()).unwrap_or(Dataset::MerlNbrdf);
+            let key = CellKey { dataset, object: object.clone(), model, options, metric: *metric };
+            cells.push((key, value));
+        }
     }
-    Ok(PaperTable { file, dataset, columns, rows })
+    Ok(PaperTable { file, label, cells })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use MetricKind::*;
 
     /// The shape of the paper's tables: Table 1 has the nine models in the paper's order, five
-    /// columns on MERL (with RMSE∛) and four on DiLiGenT-MV (no BRDF ground truth); the
-    /// supplement's table has every model on each of DiLiGenT-MV's five objects.
+    /// columns on MERL (RMSE∛ first) and four on DiLiGenT-MV (no BRDF ground truth); the
+    /// supplement's table has every model on each of DiLiGenT-MV's five objects; the ablations
+    /// have the paper's 14 rows a scene.
     #[test]
     fn each_file_has_the_rows_and_columns_of_the_papers_table() {
-        let merl = table1_merl().unwrap();
-        let models: Vec<ModelKind> = merl.rows.iter().map(|r| r.model).collect();
-        assert_eq!(models, ModelKind::ALL);
-        use MetricKind::*;
-        assert_eq!(merl.columns, [Psnr, Dssim, Lpips, Flip, CubeRootRmse]);
-        assert_eq!(merl.cells(), 45);
-        let mv = table1_diligent_mv().unwrap();
-        assert_eq!(mv.rows.iter().map(|r| r.model).collect::<Vec<_>>(), ModelKind::ALL);
-        assert_eq!(mv.columns, [Psnr, Dssim, Lpips, Flip]);
-        let per = per_object_diligent_mv().unwrap();
-        assert_eq!(per.rows.len(), 45);
-        let mut objects: Vec<&str> = per.rows.iter().filter_map(|r| r.object.as_deref()).collect();
-        objects.dedup();
-        assert_eq!(objects, ["bear", "buddha", "cow", "pot2", "reading"]);
-        for o in objects {
-            let m: Vec<ModelKind> = per
-                .rows
+        let t1 = table1().unwrap();
+        let (merl, mv) = (Dataset::MerlNbrdf, Dataset::DiligentMv);
+        assert_eq!(t1.rows().iter().map(|r| r.0).collect::<Vec<_>>(), ModelKind::ALL);
+        assert_eq!(t1.datasets(), [merl.clone(), mv.clone()]);
+        assert_eq!(t1.metrics(&merl), [CubeRootRmse, Psnr, Dssim, Lpips, Flip]);
+        assert_eq!(t1.metrics(&mv), [Psnr, Dssim, Lpips, Flip]);
+        assert_eq!((t1.len(), t1.transcribed()), (81, 81));
+        let per = table("per-object-diligent-mv.csv").unwrap();
+        assert_eq!(per.objects(), ["bear", "buddha", "cow", "pot2", "reading"]);
+        assert_eq!(per.len(), 5 * 9 * 4);
+        let ablation_rows: usize =
+            ["nol.csv", "reciprocity-quality.csv", "view-light.csv", "nerfactor.csv"]
                 .iter()
-                .filter(|r| r.object.as_deref() == Some(o))
-                .map(|r| r.model)
-                .collect();
-            assert_eq!(m, ModelKind::ALL, "{o}");
-        }
-        assert_eq!(per.columns, mv.columns);
-        // Whatever is transcribed is within each metric's printed range.
-        for t in [&merl, &mv, &per] {
-            for r in &t.rows {
-                for (v, m) in r.values.iter().zip(&t.columns) {
-                    if let Some(v) = v {
-                        let ok = if *m == Psnr { (10.0..80.0).contains(v) } else { *v >= 0.0 };
-                        assert!(ok, "{}: {m:?} {v}", t.file);
-                    }
+                .map(|f| table(f).unwrap().rows().len())
+                .sum();
+        assert_eq!(ablation_rows, 14);
+        let energy = table("energy.csv").unwrap();
+        assert_eq!(energy.rows().len(), 7);
+        let no_number = energy.cells.iter().filter(|c| c.1 == PaperValue::NoNumber).count();
+        assert_eq!(no_number, 2, "RP's medians: all valid");
+        // Every number is in its metric's printed range.
+        for t in all_tables().unwrap() {
+            assert_eq!(t.transcribed(), t.len(), "{}", t.file);
+            for (k, v) in &t.cells {
+                if let PaperValue::Printed(v) = v {
+                    let delta = t.rows().iter().any(|r| r.1 != RunOptions::DEFAULT)
+                        && !t.file.starts_with("reciprocity-rmse");
+                    let ok = match k.metric {
+                        _ if delta => v.abs() < 5.0,
+                        Psnr => (10.0..80.0).contains(v),
+                        _ => *v >= 0.0,
+                    };
+                    assert!(ok, "{}: {k:?} {v}", t.file);
                 }
             }
         }
     }
 
     #[test]
-    fn the_quoted_ranges_parse_and_are_ordered() {
-        let r = ranges().unwrap();
-        assert_eq!(r.len(), 2);
-        assert!(r.iter().all(|r| r.min <= r.max && r.metric == MetricKind::Psnr));
-        let neural = r.iter().find(|r| r.group == ModelGroup::PurelyNeural).unwrap();
-        let parametric = r.iter().find(|r| r.group == ModelGroup::Parametric).unwrap();
-        assert!(neural.min > parametric.max, "the paper's neural rows are above the parametric");
+    fn values_are_found_by_their_key() {
+        let t1 = table1().unwrap();
+        let v = t1.value(&Dataset::MerlNbrdf, ModelKind::Rp, RunOptions::DEFAULT, None, Psnr);
+        assert_eq!(v, Some(44.05));
+        let nol = table("nol.csv").unwrap();
+        let o = VARIANTS[1].1;
+        let v = nol.value(&Dataset::DiligentMv, ModelKind::AdditiveShared, o, None, Psnr);
+        assert_eq!(v, Some(-0.37));
+        assert_eq!(variant_name(o), Some("nol"));
     }
 
     #[test]
     fn bad_files_are_named_with_their_line() {
-        let bad = "model,PSNR\nRP,abc\n";
-        let e = parse_table(("x.csv", bad), Dataset::MerlNbrdf, false).unwrap_err();
+        let e = parse("x.csv", "t", "model,merl:PSNR\nRP,abc\n").unwrap_err();
         assert_eq!((e.file, e.line), ("x.csv", 2));
         assert!(e.to_string().contains("\"abc\""), "{e}");
-        let e = parse_table(("y.csv", "model,PSNR\nPhong,1\n"), Dataset::MerlNbrdf, false);
-        assert!(e.unwrap_err().fault.contains("unknown model"));
-        let e = parse_table(("z.csv", "model,PSNR,XYZ\n"), Dataset::MerlNbrdf, false);
-        assert!(e.unwrap_err().fault.contains("XYZ"));
+        let e = parse("y.csv", "t", "model,merl:PSNR\nPhong,1\n").unwrap_err();
+        assert!(e.fault.contains("unknown model"));
+        let e = parse("z.csv", "t", "model,merl:XYZ\n").unwrap_err();
+        assert!(e.fault.contains("XYZ"));
+        let e = parse("w.csv", "t", "model,PSNR\n").unwrap_err();
+        assert!(e.fault.contains("names no data set"), "{e}");
+        let e = parse("v.csv", "t", "model,variant,merl:PSNR\nRP,twice,1\n").unwrap_err();
+        assert!(e.fault.contains("unknown variant"), "{e}");
+        let e = parse("u.csv", "t", "model,merl:PSNR\nRP,1,2\n").unwrap_err();
+        assert!(e.fault.contains("3 fields"), "{e}");
     }
 
     #[test]
