@@ -107,7 +107,8 @@ enum Command {
     /// every run (finished runs are skipped, interrupted ones resume), then write the tables
     /// (Markdown, LaTeX) and figures (PNG) into OUT/tables and OUT/figures.
     ReproduceTables {
-        /// Built-in profile (default, quick, smoke, runtime, full, real) or a profile TOML file.
+        /// Built-in profile (default, quick, smoke, runtime, full, real, figure, all-tables) or a
+        /// profile TOML file.
         #[arg(long, default_value = sweep::DEFAULT_PROFILE)]
         profile: String,
         /// Output directory (scenes, runs, cache, tables, figures).

@@ -7,7 +7,7 @@
 //! and two profiles that share a run (the quick profile and the run-time curve) share its
 //! directory.
 
-use super::profile::{Ablation, CaptureSource, SweepProfile, mesh_name};
+use super::profile::{Ablation, AblationModels, CaptureSource, SweepProfile, mesh_name};
 use brdf_neural::{AngleParametrization, ModelKind, Reciprocity};
 use experiments::{Error, Result};
 use report::RunOptions;
@@ -149,10 +149,19 @@ pub fn runs(profile: &SweepProfile) -> Result<Vec<RunSpec>> {
     let d = RunOptions::DEFAULT;
     let models = profile.models()?;
     // The ablations apply to the profile's purely neural models (NeRFactor's to the additive
-    // ones among them).
-    let neural: Vec<ModelKind> =
-        purely_neural().into_iter().filter(|k| models.contains(k)).collect();
-    let additive: Vec<ModelKind> = neural.iter().copied().filter(|k| k.is_additive()).collect();
+    // ones among them): the paper's rows (the three vanilla models; NeRFactor's on Add. Sep.)
+    // or all of them.
+    let paper_rows = profile.sweep.ablation_models == AblationModels::Paper;
+    let vanilla = [ModelKind::SingleMlp, ModelKind::AdditiveSeparate, ModelKind::AdditiveShared];
+    let neural: Vec<ModelKind> = purely_neural()
+        .into_iter()
+        .filter(|k| models.contains(k) && (!paper_rows || vanilla.contains(k)))
+        .collect();
+    let additive: Vec<ModelKind> = neural
+        .iter()
+        .copied()
+        .filter(|&k| k.is_additive() && (!paper_rows || k == ModelKind::AdditiveSeparate))
+        .collect();
     // The run-time curve: the Table 1 runs on its scene keep snapshots (the plateau schedule
     // does not depend on the budget, so a snapshot is what a shorter run would have given).
     let curve_scene = profile.sweep.runtime_curve.then_some(profile.sweep.runtime_scene);
@@ -258,19 +267,29 @@ mod tests {
         assert!(d.iter().all(|r| r.purposes == [Purpose::Table] && !r.config.train.snapshots));
         let smoke = SweepProfile::load("smoke").unwrap();
         let r = runs(&smoke).unwrap();
-        // Per scene: 9 Table 1 runs, 5 NOL, 10 reciprocity, 5 angle, 8 NeRFactor ablations; the
-        // run-time curve is the Table 1 runs of scene 0, with snapshots.
-        assert_eq!(r.len(), 2 * (9 + 5 + 10 + 5 + 8));
+        // Per scene: 9 Table 1 runs and the paper's 14 ablation rows (3 NOL, 6 reciprocity, 3
+        // angle, 2 NeRFactor); the run-time curve is the Table 1 runs of scene 0, with
+        // snapshots.
+        assert_eq!(r.len(), 2 * (9 + 3 + 6 + 3 + 2));
+        let mut every = smoke.clone();
+        every.sweep.ablation_models = AblationModels::All;
+        assert_eq!(runs(&every).unwrap().len(), 2 * (9 + 5 + 10 + 5 + 8));
         let curve: Vec<&RunSpec> =
             r.iter().filter(|r| r.purposes.contains(&Purpose::Runtime)).collect();
         assert_eq!(curve.len(), 9);
         assert!(curve.iter().all(|r| r.scene == 0 && r.config.train.snapshots));
         assert!(curve.iter().all(|r| r.purposes.contains(&Purpose::Table)));
         // The paper's scale (docs/reproduce.md sizes its cost from this count): 25 scenes
-        // (materials zipped with the 9 meshes), each with the smoke profile's 37 runs.
+        // (materials zipped with the 9 meshes), each with the smoke profile's 23 runs.
         let full = SweepProfile::load("full").unwrap();
         assert_eq!(scenes(&full).len(), 25);
-        assert_eq!(runs(&full).unwrap().len(), 25 * (9 + 5 + 10 + 5 + 8));
+        assert_eq!(runs(&full).unwrap().len(), 25 * (9 + 14));
+        // Every table at the default's scale: the default's 27 runs (the same ones) and 14
+        // ablation rows on each of its 3 scenes; the ball joins when present.
+        let all = SweepProfile::load("all-tables").unwrap();
+        let a = runs(&all).unwrap();
+        assert_eq!(a.iter().filter(|r| r.scene < 3).count(), 3 * (9 + 14));
+        assert!(d.iter().all(|r| a.iter().any(|x| x.config == r.config && x.scene == r.scene)));
         let runtime = SweepProfile::load("runtime").unwrap();
         let rt = runs(&runtime).unwrap();
         assert_eq!(rt.len(), 9);

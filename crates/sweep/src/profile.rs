@@ -1,8 +1,8 @@
 //! Sweep profiles: which scenes, models, ablations and training budgets a reproduction runs.
 //!
 //! A profile is a TOML file. The built-in ones live in `crates/sweep/profiles/` and are
-//! compiled in (`default`, `smoke`, `quick`, `runtime`, `full`, `real`); `--profile` takes one of those names or
-//! a path to a file of the same shape:
+//! compiled in (`default`, `smoke`, `quick`, `runtime`, `full`, `real`, `figure`, `all-tables`);
+//! `--profile` takes one of those names or a path to a file of the same shape:
 //!
 //! ```toml
 //! name = "quick"
@@ -26,6 +26,7 @@
 //! [sweep]
 //! models = ["all"]                # Table 1 rows (paper names or config names)
 //! ablations = ["nol", "reciprocity", "angles", "nerfactor"]
+//! ablation_models = "paper"       # the paper's 14 rows a scene; "all": every neural model (28)
 //! runtime_curve = true            # snapshots of the Table 1 runs on one scene, each scored
 //! runtime_scene = 0               # which scene the curve runs on
 //! ```
@@ -41,13 +42,15 @@ use serde::Deserialize;
 use std::path::Path;
 
 /// The built-in profiles: (name, TOML text).
-pub const BUILT_IN: [(&str, &str); 6] = [
+pub const BUILT_IN: [(&str, &str); 8] = [
     ("default", include_str!("../profiles/default.toml")),
     ("smoke", include_str!("../profiles/smoke.toml")),
     ("quick", include_str!("../profiles/quick.toml")),
     ("runtime", include_str!("../profiles/runtime.toml")),
     ("full", include_str!("../profiles/full.toml")),
     ("real", include_str!("../profiles/real.toml")),
+    ("figure", include_str!("../profiles/figure.toml")),
+    ("all-tables", include_str!("../profiles/all-tables.toml")),
 ];
 
 /// The profile `reproduce-tables` runs without `--profile`: Table 1 with every run trained to
@@ -112,12 +115,27 @@ pub struct SweepSection {
     pub models: Vec<String>,
     /// Ablation groups: `nol`, `reciprocity`, `angles`, `nerfactor`.
     pub ablations: Vec<String>,
+    /// Which models the ablations run on: the paper's rows (default) or every neural model.
+    pub ablation_models: AblationModels,
     /// Record the run-time curve: the Table 1 runs on `runtime_scene` keep weight snapshots
     /// (`train.snapshots`) and `eval` scores each of them (all nine models when `models` is
     /// empty).
     pub runtime_curve: bool,
     /// Index of the scene the curve runs on.
     pub runtime_scene: usize,
+}
+
+/// Which models the ablation groups run on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AblationModels {
+    /// The paper's rows: NOL, reciprocity and view-light on Single MLP, Add. Sep. and Add.
+    /// Shared, NeRFactor's changes on Add. Sep. (14 runs a scene with every group).
+    #[default]
+    Paper,
+    /// Every purely neural model, the enhanced splits too, and NeRFactor's changes on every
+    /// additive model (28 runs a scene).
+    All,
 }
 
 /// A parsed profile.
