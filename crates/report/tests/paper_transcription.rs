@@ -16,7 +16,7 @@ type TexCell = (Dataset, Option<String>, ModelKind, &'static str, MetricKind, Pa
 
 /// The `tabular` body of the table or figure labelled `label`: the last one that ends before
 /// the label, comments removed.
-fn tabular<'a>(tex: &'a str, label: &str) -> String {
+fn tabular(tex: &str, label: &str) -> String {
     let at = tex.find(&format!("\\label{{{label}}}")).unwrap_or_else(|| panic!("no {label}"));
     let end = tex[..at].rfind("\\end{tabular}").expect("a tabular before the label");
     let begin = tex[..end].rfind("\\begin{tabular}").expect("its begin");

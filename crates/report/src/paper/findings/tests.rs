@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::paper::data::{self, PaperValue};
+use metrics::aggregate::Score;
 
 const OBJECTS: [(&str, f64); 3] = [("a", -0.01), ("b", 0.0), ("c", 0.01)];
 
@@ -87,11 +88,10 @@ fn moved(
         .iter()
         .cloned()
         .map(|mut r| {
-            if r.model == model && r.options == options && &r.dataset == dataset {
-                if let Some(metrics::aggregate::Score::Value(v)) = r.metrics.get(&metric).cloned() {
-                    let shift = by(&r.object);
-                    r = r.with_value(metric, v + shift);
-                }
+            let here = r.model == model && r.options == options && &r.dataset == dataset;
+            if let (true, Some(Score::Value(v))) = (here, r.metrics.get(&metric).cloned()) {
+                let shift = by(&r.object);
+                r = r.with_value(metric, v + shift);
             }
             r
         })
