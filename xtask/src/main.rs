@@ -137,6 +137,11 @@ enum Command {
         /// bf16 runs get their own run ids.
         #[arg(long, value_parser = parse_precision)]
         matmul_precision: Option<MatmulPrecision>,
+        /// Only the runs of these tables of the paper, comma-separated: table1, energy, nol,
+        /// reciprocity, view-light, nerfactor (`--tables table1` on `--profile all-tables`
+        /// is the default's Table 1 alone). Without it, every table the profile plans.
+        #[arg(long, value_delimiter = ',')]
+        tables: Option<Vec<String>>,
     },
     /// Build every table and figure from the evaluated run directories below PATHS.
     Collect {
@@ -270,6 +275,7 @@ fn main() -> Result<()> {
             data,
             backend,
             matmul_precision,
+            tables,
         } => {
             reproduce::reproduce(reproduce::Options {
                 profile,
@@ -279,6 +285,7 @@ fn main() -> Result<()> {
                 data_root: data.unwrap_or_else(reproduce::default_data_root),
                 backend,
                 matmul_precision,
+                tables,
             })?;
         }
         Command::Collect { paths, out, profile } => reproduce::collect(&paths, &out, &profile)?,

@@ -24,6 +24,8 @@ pub struct Options {
     /// Precision of every run's training matrix products (`train.matmul_precision`), where
     /// given; `None` keeps the profile's.
     pub matmul_precision: Option<MatmulPrecision>,
+    /// Only the runs of these tables (`SweepProfile::with_tables`); `None`: every one.
+    pub tables: Option<Vec<String>>,
 }
 
 /// The data root: `NEURAL_BRDF_DATA`, else `./data`.
@@ -52,6 +54,9 @@ pub fn reproduce(opts: Options) -> Result<()> {
     let mut profile = SweepProfile::load(&opts.profile)?;
     if let Some(precision) = opts.matmul_precision {
         profile = profile.with_matmul_precision(precision);
+    }
+    if let Some(tables) = &opts.tables {
+        profile = profile.with_tables(tables)?;
     }
     eprintln!("profile {}: {}", profile.name, profile.description);
     // One sweep at a time per output directory, held through the tables; taking it removes
@@ -120,7 +125,7 @@ pub fn reproduce(opts: Options) -> Result<()> {
 }
 
 fn print_results(out: &Path, files: &[PathBuf]) {
-    for table in ["table1", "runtime"] {
+    for table in ["table1", "runtime", "time"] {
         let path = SweepLayout::new(out).tables().join(format!("{table}.md"));
         if let Ok(text) = std::fs::read_to_string(path) {
             println!("{text}");

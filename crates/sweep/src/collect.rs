@@ -141,6 +141,11 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
             }
         }
     }
+    // Where the time went: the last sweep into `out` (if one wrote its timing) and the runs'.
+    let timing = super::timing::SweepTiming::read(out);
+    let time = [("time".to_string(), super::timing::table(timing.as_ref(), &runs, profile))];
+    write_tables(&time, out, &mut all_md, &mut summary)?;
+    all_tables.extend(time);
     write(SweepLayout::new(out).tables().join("all.md"), all_md.as_bytes(), &mut summary)?;
     let tables = super::html_report::Tables { all: &all_tables, paper: comparison.as_ref() };
     super::html_report::write_report(out, profile, &tables, &runs, &mut summary)?;

@@ -39,6 +39,10 @@ pub struct CollectedRun {
     pub curve: Vec<RunRecord>,
     /// Why its training stopped (absent for runs of older versions).
     pub stop_reason: Option<StopReason>,
+    /// Its training's wall-clock seconds.
+    pub train_seconds: f64,
+    /// Its evaluation's wall-clock seconds.
+    pub eval_seconds: f64,
 }
 
 impl CollectedRun {
@@ -162,6 +166,8 @@ pub fn read_run(dir: &Path) -> Result<Option<CollectedRun>> {
         paper_observed,
         curve,
         stop_reason: m.stop_reason,
+        train_seconds: m.wall_seconds,
+        eval_seconds: t.seconds,
     }))
 }
 

@@ -10,6 +10,7 @@
 use super::heartbeat::Heartbeat;
 use super::plan::{self, Purpose, RunInfo, RunSpec, SceneSource, SceneSpec};
 use super::profile::{CaptureSource, SweepProfile, resolve_mesh};
+use super::timing::SweepTiming;
 use brdf_neural::device::Backend;
 use dataset_merl::generate_scene;
 use experiments::eval::fitted::FittedRun;
@@ -397,11 +398,25 @@ pub fn sweep(
     let scenes = plan::scenes(profile);
     let specs = plan::runs(profile)?;
     let scene_dirs = prepare_scenes(profile, &scenes, &scenes_dir, data_root, &mut summary)?;
+    let mut timing = SweepTiming { scenes: start.elapsed().as_secs_f64(), ..Default::default() };
     eprintln!("features: LBO tables of {} scene(s)", scene_dirs.len());
+    let features = Instant::now();
     prepare_features(&specs, &scene_dirs, &cache)?;
+    timing.features = features.elapsed().as_secs_f64();
     summary.runs = prepare_runs(&specs, &scenes, &scene_dirs, &runs_dir)?;
+    let runs = Instant::now();
     execute(&summary.runs.clone(), how, &mut summary)?;
     summary.seconds = start.elapsed().as_secs_f64();
+    if !matches!(how, Execution::Emit { .. }) {
+        timing.runs = runs.elapsed().as_secs_f64();
+        timing.total = summary.seconds;
+        timing.jobs = match how {
+            Execution::Children { jobs, .. } => *jobs,
+            _ => 1,
+        };
+        timing.completed = summary.completed;
+        timing.write(out)?;
+    }
     Ok(summary)
 }
 

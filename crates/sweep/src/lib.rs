@@ -1,7 +1,7 @@
 //! Sweeps: the whole reproduction (`cargo xtask reproduce-tables`) and `collect`.
 //!
 //! * [`profile`]: the sweep profiles (`default`, `smoke`, `quick`, `runtime`, `full`, `real`,
-//!   or a TOML file).
+//!   `figure`, `all-tables`, or a TOML file).
 //! * [`plan`]: scenes and runs of a profile, content-addressed run directories.
 //! * [`execute`]: scene generation, shared LBO tables, runs in-process, as child processes
 //!   (`--jobs`) or as a job file for a cluster (`--emit-jobs`).
@@ -10,6 +10,7 @@
 //! * [`brdf_figures`]: the BRDF plots of `collect` (lit spheres, slices, albedo, validity).
 //! * [`html_report`]: the HTML report `collect` writes beside them.
 //! * [`heartbeat`]: plain progress lines when the output goes to a file.
+//! * [`timing`]: where a sweep's time went (its phases, each model's training and evaluation).
 //! * [`sources`]: mesh sources (embedded in the binary, under the data root) and real captures.
 //! * The profiles (`smoke`, `quick`, `runtime`, `full`, `real`, or a TOML file) mix generated
 //!   scenes and real captures (imported from DiLiGenT and DiLiGenT-MV).
@@ -22,6 +23,7 @@
 //! <out>/cache/                       LBO eigenpairs and feature tables
 //! <out>/runs/<object>__<model>__<options>__<steps>__<id>/   one run (config, weights, metrics,
 //!                                    renders, FLIP maps, run.json)
+//! <out>/timing.json                  the last sweep's phases ([`timing`])
 //! <out>/tables/, <out>/figures/      the results (see [`collect`])
 //! ```
 
@@ -34,6 +36,7 @@ pub mod html_report;
 pub mod plan;
 pub mod profile;
 pub mod sources;
+pub mod timing;
 
 pub use collect::collect;
 pub use collected::CollectSummary;

@@ -233,6 +233,35 @@ impl SweepProfile {
         self
     }
 
+    /// Only the runs of the paper's tables named in `tables` (`reproduce-tables --tables`):
+    /// `table1` and `energy` need Table 1's runs alone, which every profile plans; `nol`,
+    /// `reciprocity`, `view-light` and `nerfactor` keep their ablation group where the
+    /// profile has it, and a group not named is dropped.
+    pub fn with_tables(mut self, tables: &[String]) -> Result<Self> {
+        let mut keep = Vec::new();
+        for t in tables {
+            let group = match t.as_str() {
+                "table1" | "energy" => None,
+                "nol" => Some("nol"),
+                "reciprocity" => Some("reciprocity"),
+                "view-light" => Some("angles"),
+                "nerfactor" => Some("nerfactor"),
+                other => {
+                    return Err(Error::config(
+                        "--tables",
+                        format!(
+                            "unknown table {other:?} (table1, energy, nol, reciprocity, \
+                             view-light, nerfactor)"
+                        ),
+                    ));
+                }
+            };
+            keep.extend(group);
+        }
+        self.sweep.ablations.retain(|a| keep.contains(&a.as_str()));
+        Ok(self)
+    }
+
     fn validate(&self) -> Result<()> {
         let bad =
             |key: &str, why: String| Err(Error::config(key, format!("{why} (in {})", self.origin)));
@@ -380,6 +409,18 @@ impl SweepProfile {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tables_keep_their_ablations_only() {
+        let all = SweepProfile::load("all-tables").unwrap();
+        let t1 = all.clone().with_tables(&["table1".into()]).unwrap();
+        assert!(t1.sweep.ablations.is_empty());
+        assert_eq!(t1.models().unwrap().len(), 9);
+        let some = all.clone().with_tables(&["view-light".into(), "nol".into()]).unwrap();
+        assert_eq!(some.sweep.ablations, ["nol", "angles"]);
+        let e = all.with_tables(&["table9".into()]).unwrap_err().to_string();
+        assert!(e.contains("table9") && e.contains("view-light"), "{e}");
+    }
 
     #[test]
     fn built_in_profiles_parse() {

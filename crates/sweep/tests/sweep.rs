@@ -195,8 +195,16 @@ fn the_smoke_profile_runs_end_to_end() {
     assert_eq!((s.runs.len(), s.completed), (46, 46));
     let c = sweep::collect(&[out.join("runs")], &out, "smoke").unwrap();
     assert_eq!(c.runs, 46);
-    for t in ["table1", "nol", "reciprocity", "reciprocity-deltas", "angles", "nerfactor", "energy"]
-    {
+    for t in [
+        "table1",
+        "nol",
+        "reciprocity",
+        "reciprocity-deltas",
+        "angles",
+        "nerfactor",
+        "energy",
+        "time",
+    ] {
         let md = std::fs::read_to_string(out.join(format!("tables/{t}.md"))).unwrap();
         assert!(md.contains("Profile: smoke"), "{t}:\n{md}");
         if t == "table1" {
@@ -207,6 +215,12 @@ fn the_smoke_profile_runs_end_to_end() {
         }
         assert!(out.join(format!("tables/{t}.tex")).is_file());
     }
+    // Where the time went: the sweep's phases and each model's runs.
+    let time = std::fs::read_to_string(out.join("tables/time.md")).unwrap();
+    for row in ["| scenes", "| LBO features", "| runs, 1 at a time", "| training, FMBRDF |"] {
+        assert!(time.contains(row), "{row} missing from\n{time}");
+    }
+    assert!(time.contains("| evaluation, every model | ") && time.contains("| 46 |"), "{time}");
     // Every table of the paper beside ours, with the paper's rows, our value and our spread
     // over the two objects in each row's first column group.
     for (t, rows) in [
