@@ -62,13 +62,28 @@ fn values(
     if !matches!(average(last, model, options, d, m), Cell::Score(Score::Value(_))) {
         return None;
     }
+    let all = measured(last, model, options, d, m)?;
+    // Every object measured, none unavailable.
+    (all.len() == per_object(last, model, options, d, m)?.len()).then_some(all)
+}
+
+/// The per-object values of (model, options) on `d` that are numbers; `None` when not run.
+fn measured(
+    last: &[&RunRecord],
+    model: ModelKind,
+    options: RunOptions,
+    d: &Dataset,
+    m: MetricKind,
+) -> Option<Vec<(String, f64)>> {
     let per = per_object(last, model, options, d, m)?;
-    per.into_iter()
-        .map(|(o, s)| match s {
-            Score::Value(v) => Some((o, v)),
-            Score::Unavailable(_) => None,
-        })
-        .collect()
+    Some(
+        per.into_iter()
+            .filter_map(|(o, s)| match s {
+                Score::Value(v) => Some((o, v)),
+                Score::Unavailable(_) => None,
+            })
+            .collect(),
+    )
 }
 
 /// Our mean of `m` for (model, options) on `d`, with its spread over objects.
@@ -92,18 +107,7 @@ pub fn paired(
     d: &Dataset,
     m: MetricKind,
 ) -> Option<Estimate> {
-    let value = |(model, options): (ModelKind, RunOptions)| -> Option<Vec<(String, f64)>> {
-        let per = per_object(last, model, options, d, m)?;
-        Some(
-            per.into_iter()
-                .filter_map(|(o, s)| match s {
-                    Score::Value(v) => Some((o, v)),
-                    Score::Unavailable(_) => None,
-                })
-                .collect(),
-        )
-    };
-    let (va, vb) = (value(a)?, value(b)?);
+    let (va, vb) = (measured(last, a.0, a.1, d, m)?, measured(last, b.0, b.1, d, m)?);
     let diffs: Vec<f64> = va
         .iter()
         .filter_map(|(o, x)| vb.iter().find(|(p, _)| p == o).map(|(_, y)| x - y))
