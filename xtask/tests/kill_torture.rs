@@ -149,11 +149,15 @@ fn skipped(rel: &Path) -> bool {
     let s = rel.to_string_lossy();
     let name = rel.file_name().unwrap().to_string_lossy();
     // `all.md` concatenates the other tables, the run-time one included (compared one by one).
+    // `timing.json` and the time table are where the time went, and which sweep did the runs
+    // (a resumed sweep completes fewer): timing through and through.
     s.starts_with("report/")
         || name == ".lock"
         || name == "sweep.log"
         || name == "all.md"
         || name.starts_with("runtime")
+        || name == "timing.json"
+        || name.starts_with("time.")
 }
 
 fn is_timing_key(k: &str) -> bool {

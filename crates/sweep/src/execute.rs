@@ -415,7 +415,11 @@ pub fn sweep(
             _ => 1,
         };
         timing.completed = summary.completed;
-        timing.write(out)?;
+        // Where the time went is a report, not a result: a failed write (a full disk) warns
+        // and leaves the previous timing whole.
+        if let Err(e) = timing.write(out) {
+            eprintln!("warning: the sweep's timing was not written: {e}");
+        }
     }
     Ok(summary)
 }
