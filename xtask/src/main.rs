@@ -15,9 +15,10 @@ mod import_diligent;
 mod layers;
 mod publish;
 mod reproduce;
+mod slurm;
 
 use anyhow::Result;
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 use experiments::cli::{RunCommand, parse_backend};
 use experiments::{Backend, MatmulPrecision};
 use std::path::PathBuf;
@@ -142,6 +143,35 @@ enum Command {
         /// is the default's Table 1 alone). Without it, every table the profile plans.
         #[arg(long, value_delimiter = ',')]
         tables: Option<Vec<String>>,
+        #[command(flatten)]
+        slurm: SlurmArgs,
+    },
+    /// Where a sweep's runs stand (done, running, failed, interrupted, pending), read from the
+    /// run directories: also after its Slurm jobs have left the queue.
+    SweepStatus {
+        /// The sweep's output directory.
+        #[arg(default_value = "out/reproduce")]
+        out: PathBuf,
+    },
+    /// The collect job of a Slurm sweep: tables and report of the finished runs, then the failed
+    /// runs with their jobs and logs and the command that resubmits them (exit status 3 when a
+    /// run is not done).
+    SlurmCollect {
+        /// The sweep's output directory.
+        out: PathBuf,
+    },
+    /// Submit the failed runs of a Slurm sweep again (the first submission's settings), with a
+    /// new collect job.
+    SlurmResubmit {
+        /// The sweep's output directory.
+        out: PathBuf,
+        /// Also the runs that are interrupted or were never started (every run neither done
+        /// nor running).
+        #[arg(long)]
+        unfinished: bool,
+        /// Write the scripts and print the sbatch commands without submitting.
+        #[arg(long)]
+        dry_run: bool,
     },
     /// Build every table and figure from the evaluated run directories below PATHS.
     Collect {
@@ -222,6 +252,72 @@ enum Command {
     Run(RunCommand),
 }
 
+/// The Slurm flags of `reproduce-tables` (docs/guide.md, "On a cluster").
+#[derive(Args)]
+struct SlurmArgs {
+    /// Submit the unfinished runs to Slurm as job arrays (one task a run, requests from each
+    /// model's measured cost, requeued on preemption or time limit) with a collect job that
+    /// writes the tables, instead of running them here.
+    #[arg(long)]
+    slurm: bool,
+    /// With --slurm: write the job scripts and print the sbatch commands, submit nothing.
+    #[arg(long, requires = "slurm")]
+    dry_run: bool,
+    /// With --slurm: the partition.
+    #[arg(long, requires = "slurm")]
+    partition: Option<String>,
+    /// With --slurm: the account.
+    #[arg(long, requires = "slurm")]
+    account: Option<String>,
+    /// With --slurm: the QOS.
+    #[arg(long, requires = "slurm")]
+    qos: Option<String>,
+    /// With --slurm: an extra #SBATCH option for every job (repeatable), e.g.
+    /// `--sbatch=--constraint=avx512`.
+    #[arg(long = "sbatch", requires = "slurm", allow_hyphen_values = true)]
+    sbatch: Vec<String>,
+    /// With --slurm: CPUs a task [default: 2 on the CPU, 4 beside a GPU].
+    #[arg(long, requires = "slurm")]
+    slurm_cpus: Option<usize>,
+    /// With --slurm: memory a task in MiB [default: from the scene's size].
+    #[arg(long, requires = "slurm")]
+    slurm_mem: Option<u64>,
+    /// With --slurm: the longest time a task may ask for (Slurm's forms: `MM`, `HH:MM:SS`,
+    /// `D-HH:MM`) [default: 1-00:00]; a run that needs longer is requeued and resumes.
+    #[arg(long, requires = "slurm")]
+    slurm_max_time: Option<String>,
+    /// With --slurm: the largest array [default: the cluster's MaxArraySize].
+    #[arg(long, requires = "slurm")]
+    max_array_size: Option<usize>,
+}
+
+impl SlurmArgs {
+    fn options(self) -> Result<Option<sweep::slurm::SlurmOptions>> {
+        if !self.slurm {
+            return Ok(None);
+        }
+        let max_minutes = match &self.slurm_max_time {
+            None => None,
+            Some(t) => Some(sweep::slurm::requests::parse_slurm_time(t).ok_or_else(|| {
+                anyhow::anyhow!("--slurm-max-time {t:?}: not a Slurm time (MM, HH:MM:SS, D-HH:MM)")
+            })?),
+        };
+        Ok(Some(sweep::slurm::SlurmOptions {
+            partition: self.partition,
+            account: self.account,
+            qos: self.qos,
+            extra: self.sbatch,
+            requests: sweep::slurm::requests::RequestSettings {
+                cpus: self.slurm_cpus,
+                mem_mib: self.slurm_mem,
+                max_minutes,
+            },
+            max_array_size: self.max_array_size,
+            dry_run: self.dry_run,
+        }))
+    }
+}
+
 /// `--matmul-precision`: `f32` or `bf16`.
 fn parse_precision(name: &str) -> std::result::Result<MatmulPrecision, String> {
     match name {
@@ -276,6 +372,7 @@ fn main() -> Result<()> {
             backend,
             matmul_precision,
             tables,
+            slurm,
         } => {
             reproduce::reproduce(reproduce::Options {
                 profile,
@@ -286,7 +383,13 @@ fn main() -> Result<()> {
                 backend,
                 matmul_precision,
                 tables,
+                slurm: slurm.options()?,
             })?;
+        }
+        Command::SweepStatus { out } => slurm::status(&out)?,
+        Command::SlurmCollect { out } => slurm::collect(&out)?,
+        Command::SlurmResubmit { out, unfinished, dry_run } => {
+            slurm::resubmit(&out, unfinished, dry_run)?
         }
         Command::Collect { paths, out, profile } => reproduce::collect(&paths, &out, &profile)?,
         Command::PublishTables { out } => {

@@ -26,6 +26,8 @@ pub struct Options {
     pub matmul_precision: Option<MatmulPrecision>,
     /// Only the runs of these tables (`SweepProfile::with_tables`); `None`: every one.
     pub tables: Option<Vec<String>>,
+    /// Submit the runs to Slurm as job arrays with these settings instead of running them.
+    pub slurm: Option<sweep::slurm::SlurmOptions>,
 }
 
 /// The data root: `NEURAL_BRDF_DATA`, else `./data`.
@@ -70,7 +72,16 @@ pub fn reproduce(opts: Options) -> Result<()> {
             lock.removed_temporaries
         );
     }
+    anyhow::ensure!(
+        opts.slurm.is_none() || opts.emit_jobs.is_none(),
+        "--slurm and --emit-jobs are two ways to hand the runs to a cluster: choose one"
+    );
     let how = match (&opts.emit_jobs, opts.jobs) {
+        _ if opts.slurm.is_some() => Execution::Slurm {
+            program: run_one_command(opts.backend)?.swap_remove(0),
+            backend: opts.backend,
+            options: opts.slurm.clone().unwrap_or_default(),
+        },
         (Some(file), _) => {
             Execution::Emit { file: file.clone(), command: run_one_command(opts.backend)? }
         }
@@ -91,12 +102,16 @@ pub fn reproduce(opts: Options) -> Result<()> {
     for (dir, why) in &s.failed {
         eprintln!("  failed: {}: {why}", dir.display());
     }
+    if let Some(submission) = &s.submission {
+        crate::slurm::print_submission(&opts.out, submission);
+        return Ok(());
+    }
     if let Execution::Emit { file, .. } = &how {
         eprintln!(
-            "wrote {} job command(s) to {} (one per line, e.g. for a Slurm array: \
-             sed -n \"${{SLURM_ARRAY_TASK_ID}}p\" {} | sh); then run `cargo xtask collect {}`",
+            "wrote {} job command(s) to {} (one per line, for your scheduler; on Slurm, \
+             `--slurm` submits them as job arrays that requeue and collect); then run \
+             `cargo xtask collect {}`",
             s.emitted,
-            file.display(),
             file.display(),
             SweepLayout::new(&opts.out).runs().display()
         );
@@ -145,8 +160,28 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<()> {
     Ok(())
 }
 
-/// Runs `run-one` (what `--jobs` children and emitted job lines execute).
+/// Runs `run-one` (what `--jobs` children, emitted job lines and Slurm tasks execute). A
+/// SIGTERM or SIGUSR1 stops it for a requeue: a checkpoint is written and the process exits with
+/// `experiments::interrupt::EXIT_REQUEUE`.
 pub fn run_one(dir: &Path, progress: bool, backend: Backend) -> Result<()> {
     sweep::exit_with_parent();
-    sweep::run_one(dir, progress, backend).with_context(|| format!("run {}", dir.display()))
+    experiments::interrupt::install();
+    match sweep::run_one(dir, progress, backend)
+        .with_context(|| format!("run {}", dir.display()))?
+    {
+        sweep::RunEnd::Done => Ok(()),
+        sweep::RunEnd::Interrupted(step) => {
+            match step {
+                Some(step) => eprintln!(
+                    "{}: stopped by a signal after step {step}, checkpoint written; the next start resumes it",
+                    dir.display()
+                ),
+                None => eprintln!(
+                    "{}: stopped by a signal after training; the next start evaluates it",
+                    dir.display()
+                ),
+            }
+            std::process::exit(experiments::interrupt::EXIT_REQUEUE)
+        }
+    }
 }

@@ -7,7 +7,8 @@
 //! * [`data`]: the lit training records (spatial features, local directions, E cos) and batches.
 //! * [`loss`]: the sRGB-gamma MSE and the enhanced split's regularisers.
 //! * [`train`], [`trainer`]: [`fit`] and its loop: validation, checkpoints, snapshots, resume
-//!   and non-finite detection ([`checkpoint`], [`diagnose`]).
+//!   and non-finite detection ([`checkpoint`], [`diagnose`]); [`interrupt`]: a SIGTERM (a
+//!   cluster's preemption or time limit) ends a fit at a step boundary with a checkpoint.
 //! * [`eval`]: test renders, maps and every metric of a finished run.
 //! * [`export`]: a fitted model for renderers (glTF, Mitsuba 3, pbrt-v4) and as a MERL table.
 //!
@@ -38,6 +39,7 @@ pub mod diagnose;
 mod error;
 pub mod eval;
 pub mod export;
+pub mod interrupt;
 pub mod loss;
 mod loss_window;
 pub mod train;

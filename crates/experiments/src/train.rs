@@ -78,7 +78,8 @@ pub enum FitOutcome {
     },
     /// The run directory already held a finished run; nothing was done.
     AlreadyFinished(RunMetrics),
-    /// Stopped by [`FitOptions::stop_after`] after this many steps.
+    /// Stopped after this many steps, with a checkpoint, by [`FitOptions::stop_after`] or by a
+    /// signal ([`crate::interrupt`]).
     Stopped(u64),
 }
 
@@ -246,6 +247,9 @@ pub fn fit_and_keep(
         (model, optim, state) = checkpoint::load(dir, model, optim)?;
     }
     let resumed_from = state.step;
+    if resumed_from > 0 {
+        eprintln!("{}: resuming from the checkpoint at step {resumed_from}", run.display());
+    }
     let bar = progress_bar(options.progress, t.iterations, state.step);
     let on_device = options.inputs_on_device.unwrap_or(options.backend.is_gpu());
     let spatial = device_table(&config.model, &data, on_device, &device)?;

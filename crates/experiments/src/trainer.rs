@@ -94,7 +94,8 @@ fn tensor(values: Vec<f32>, rows: usize, device: &Device) -> Tensor<2> {
 
 impl Loop<'_> {
     /// Trains from `state` until the plateau rule or the budget stops it, or until
-    /// `stop_after` steps (then checkpointed and reported as interrupted).
+    /// `stop_after` steps or a stop requested by a signal ([`crate::interrupt`]; then
+    /// checkpointed and reported as interrupted).
     pub fn run(
         &self,
         mut model: BrdfModel,
@@ -109,6 +110,8 @@ impl Loop<'_> {
         let mut window = (Instant::now(), state.step);
         let mut timer = PhaseTimer::start(std::mem::take(&mut state.phases));
         let mut losses = LossWindow::default();
+        // A SIGTERM from here on stops at a step boundary ([`crate::interrupt`]).
+        let _training = crate::interrupt::Training::begin();
         while state.step < t.iterations && state.stopped.is_none() {
             let step = state.step;
             if losses.is_empty() {
@@ -184,7 +187,8 @@ impl Loop<'_> {
             if state.step >= t.iterations && state.stopped.is_none() {
                 state.stopped = Some(StopReason::Budget);
             }
-            let interrupted = stop_after.is_some_and(|s| state.step >= s);
+            let interrupted =
+                stop_after.is_some_and(|s| state.step >= s) || crate::interrupt::requested();
             if state.step.is_multiple_of(t.checkpoint_every)
                 || interrupted
                 || state.stopped.is_some()
@@ -212,6 +216,7 @@ impl Loop<'_> {
             || (t.snapshots && t.snapshot_steps().contains(&step))
             || step >= t.iterations
             || stop_after.is_some_and(|s| step >= s)
+            || crate::interrupt::requested()
     }
 
     /// Puts back the model and optimiser of the window's start and repeats its steps reading

@@ -15,9 +15,11 @@
 //! <run>/probe.bin          eval: the model on the BRDF plots' probes (sphere, slices, albedo,
 //!                          validity maps; `eval::probe`)
 //! <run>/run.json           sweep runs only: id, object, dataset, purposes, code version
-//! <run>/sweep.log          sweep runs in child processes: their output
+//! <run>/sweep.log          sweep runs in child processes and cluster tasks: their output
+//! <run>/failure.json       sweep runs: the error of the last start, when it failed
 //!
 //! <out>/scenes/  <out>/runs/<run>/  <out>/cache/  <out>/tables/  <out>/figures/   (a sweep)
+//! <out>/slurm/   a sweep submitted to Slurm (`sweep::slurm`)
 //! ```
 //!
 //! The cache (eigenpairs, LBO tables, noise ceilings) of a run is, in this order: the one
@@ -119,6 +121,11 @@ impl RunDir {
         self.0.join("sweep.log")
     }
 
+    /// `failure.json`: why the last start of a sweep's run failed (removed by the next start).
+    pub fn failure(&self) -> PathBuf {
+        self.0.join("failure.json")
+    }
+
     /// Whether the run finished training (weights and metrics written).
     pub fn is_trained(&self) -> bool {
         self.weights().is_file() && self.metrics().is_file()
@@ -190,6 +197,11 @@ impl SweepLayout {
     /// The HTML report (`index.html`, run pages and their images).
     pub fn report(&self) -> PathBuf {
         self.0.join("report")
+    }
+
+    /// The Slurm submissions (`slurm/sweep.json`, job scripts, task lists, Slurm's logs).
+    pub fn slurm(&self) -> PathBuf {
+        self.0.join("slurm")
     }
 }
 

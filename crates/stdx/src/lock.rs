@@ -55,7 +55,7 @@ impl DirLock {
             }
             Err(std::fs::TryLockError::Error(e)) => return Err(Error::new(&path, e)),
         }
-        let note = format!("process {} ({what})", std::process::id());
+        let note = format!("process {} on {} ({what})", std::process::id(), host_name());
         file.set_len(0)
             .and_then(|()| file.write_all(note.as_bytes()))
             .map_err(|e| Error::new(&path, e))?;
@@ -67,6 +67,37 @@ impl DirLock {
     pub fn dir(&self) -> &Path {
         &self.dir
     }
+}
+
+/// The holder's note (`process <pid> on <host> (<what>)`) when another open lock holds `dir`'s
+/// lock, `None` when nobody does (or `dir` has no lock file). Reads only: the lock, when free,
+/// is taken and released at once, and no temporary is removed.
+///
+/// Across hosts this is as good as the file system's locks: local disks and NFS (v4, or v3
+/// with its lock manager; Linux maps `flock` onto NFS byte-range locks) hold them; Lustre needs
+/// its `flock` mount option.
+pub fn holder(dir: &Path) -> Option<String> {
+    let path = dir.join(LOCK_FILE);
+    let file = std::fs::OpenOptions::new().read(true).write(true).open(&path).ok()?;
+    match file.try_lock() {
+        Err(std::fs::TryLockError::WouldBlock) => {
+            let note = std::fs::read_to_string(&path).unwrap_or_default();
+            let note = note.trim();
+            Some(if note.is_empty() { "another process".into() } else { note.into() })
+        }
+        _ => None,
+    }
+}
+
+/// This machine's host name (Linux's `/proc`, else `$HOSTNAME`, else `unknown host`): locks
+/// name it, so that a holder on another node of a cluster is found.
+pub fn host_name() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .map(|h| h.trim().to_string())
+        .filter(|h| !h.is_empty())
+        .unwrap_or_else(|| "unknown host".into())
 }
 
 /// Whether `dir` holds a lock file that another open lock holds (a folder a live process works
@@ -96,7 +127,10 @@ mod tests {
         assert!(d.join("sub/kept.json").is_file());
         let err = DirLock::acquire(&d, "evaluating").unwrap_err().to_string();
         assert!(err.contains(&d.display().to_string()), "{err}");
-        assert!(err.contains(&format!("process {} (training)", std::process::id())), "{err}");
+        let note = format!("process {} on {} (training)", std::process::id(), host_name());
+        assert!(err.contains(&note), "{err}");
+        assert_eq!(holder(&d).as_deref(), Some(note.as_str()));
+        assert_eq!(holder(&d.join("sub")), None, "no lock file there yet");
         // A sub-folder locked by another holder keeps its temporaries.
         let inner = DirLock::acquire(&d.join("sub"), "training").unwrap();
         std::fs::write(d.join("sub/.curve.csv.tmp-1"), b"live").unwrap();
@@ -108,6 +142,8 @@ mod tests {
         let again = DirLock::acquire(&d, "evaluating").unwrap();
         assert_eq!(again.removed_temporaries, 1, "the sub-folder is free now");
         drop(again);
+        assert_eq!(holder(&d), None, "released");
+        assert!(DirLock::acquire(&d, "again").is_ok(), "holder() leaves the lock free");
         std::fs::remove_dir_all(&d).unwrap();
     }
 }

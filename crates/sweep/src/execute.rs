@@ -37,6 +37,15 @@ pub enum Execution {
         /// The program and leading arguments that run one run directory.
         command: Vec<String>,
     },
+    /// Submit the unfinished runs to Slurm as job arrays with a collect job ([`crate::slurm`]).
+    Slurm {
+        /// The xtask executable the tasks run (absolute).
+        program: String,
+        /// The backend of the runs.
+        backend: Backend,
+        /// The submission's settings.
+        options: crate::slurm::SlurmOptions,
+    },
     /// Write the commands to this file (one line per unfinished run) and run nothing.
     Emit {
         /// The job file.
@@ -63,6 +72,8 @@ pub struct SweepSummary {
     pub failed: Vec<(PathBuf, String)>,
     /// Commands written (`Emit`).
     pub emitted: usize,
+    /// The Slurm submission (`Slurm`).
+    pub submission: Option<crate::slurm::Submission>,
     /// Wall-clock seconds.
     pub seconds: f64,
 }
@@ -98,13 +109,39 @@ pub fn is_done(run: &Path) -> bool {
     RunDir::new(run).is_evaluated()
 }
 
+/// How [`run_one`] ended without an error.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RunEnd {
+    /// Trained and evaluated (or found so).
+    Done,
+    /// Stopped by a signal for a requeue ([`experiments::interrupt`]): a checkpoint of this
+    /// step is written (`None`: training had ended; the evaluation is left to the next start).
+    Interrupted(Option<u64>),
+}
+
 /// Fits (resuming) and evaluates one prepared run directory. The configuration is read once;
 /// a run trained here is evaluated with the model and scene training hands over, on the
 /// backend it trained on.
-pub fn run_one(run: &Path, progress: bool, backend: Backend) -> Result<()> {
+///
+/// A failure is also recorded in the run directory ([`crate::status::Failure`], what
+/// `sweep-status` and a cluster's collect job list); the next start clears it. A run another
+/// process works in is refused without a record (that process's start is the one that counts).
+pub fn run_one(run: &Path, progress: bool, backend: Backend) -> Result<RunEnd> {
     if is_done(run) {
-        return Ok(());
+        return Ok(RunEnd::Done);
     }
+    if let Some(holder) = stdx::lock::holder(run) {
+        return Err(Error::format(run, format!("in use by {holder}")));
+    }
+    crate::status::Failure::clear(run);
+    let end = fit_and_evaluate(run, progress, backend);
+    if let Err(e) = &end {
+        crate::status::Failure::record(run, &e.to_string());
+    }
+    end
+}
+
+fn fit_and_evaluate(run: &Path, progress: bool, backend: Backend) -> Result<RunEnd> {
     let dir = RunDir::new(run);
     let config = dir.read_config()?;
     let cache = dir.cache(&config, None);
@@ -116,14 +153,20 @@ pub fn run_one(run: &Path, progress: bool, backend: Backend) -> Result<()> {
         ..Default::default()
     };
     let fitted = match fit_and_keep(&config, run, options)? {
+        (FitOutcome::Stopped(step), _) if experiments::interrupt::requested() => {
+            return Ok(RunEnd::Interrupted(Some(step)));
+        }
         (FitOutcome::Stopped(step), _) => {
             return Err(Error::format(run, format!("training stopped at step {step}")));
         }
+        // The grace period after the signal is too short for an evaluation: the next start
+        // evaluates the weights just written.
+        _ if experiments::interrupt::requested() => return Ok(RunEnd::Interrupted(None)),
         (_, Some(trained)) => trained.into_fitted(config, cache),
         (_, None) => FittedRun::open_on(run, None, Some(&cache), backend)?,
     };
     experiments::eval::eval_fitted(&fitted, run, progress, Instant::now())?;
-    Ok(())
+    Ok(RunEnd::Done)
 }
 
 /// Generates the profile's semi-synthetic scenes and imports its captures under `scenes_dir`
@@ -259,7 +302,7 @@ pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) ->
     let lines = match how {
         Execution::InProcess(_) => Heartbeat::start(todo.len(), 1),
         Execution::Children { jobs, .. } => Heartbeat::start(todo.len(), *jobs),
-        Execution::Emit { .. } => Heartbeat::start(0, 1),
+        Execution::Emit { .. } | Execution::Slurm { .. } => Heartbeat::start(0, 1),
     };
     match how {
         Execution::InProcess(backend) => {
@@ -267,7 +310,11 @@ pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) ->
                 bar.set_message(short(d));
                 lines.started(d);
                 match bar.suspend(|| run_one(d, true, *backend)) {
-                    Ok(()) => {
+                    Ok(RunEnd::Interrupted(_)) => {
+                        summary.failed.push(((*d).clone(), "interrupted by a signal".into()));
+                        lines.finished(d, false);
+                    }
+                    Ok(RunEnd::Done) => {
                         summary.completed += 1;
                         lines.finished(d, true);
                     }
@@ -343,6 +390,8 @@ pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) ->
             stdx::fs::write_atomic(file, text.as_bytes())?;
             summary.emitted = todo.len();
         }
+        // Submitted by `sweep`, which knows the output directory.
+        Execution::Slurm { .. } => {}
     }
     bar.finish_and_clear();
     Ok(())
@@ -406,8 +455,14 @@ pub fn sweep(
     summary.runs = prepare_runs(&specs, &scenes, &scene_dirs, &runs_dir)?;
     let runs = Instant::now();
     execute(&summary.runs.clone(), how, &mut summary)?;
+    if let Execution::Slurm { program, backend, options } = how {
+        let todo: Vec<PathBuf> = summary.runs.iter().filter(|d| !is_done(d)).cloned().collect();
+        let first = (profile.name.as_str(), program.as_str(), backend.name());
+        summary.submission =
+            Some(crate::slurm::submit(out, &summary.runs, &todo, Some(first), options)?);
+    }
     summary.seconds = start.elapsed().as_secs_f64();
-    if !matches!(how, Execution::Emit { .. }) {
+    if !matches!(how, Execution::Emit { .. } | Execution::Slurm { .. }) {
         timing.runs = runs.elapsed().as_secs_f64();
         timing.total = summary.seconds;
         timing.jobs = match how {

@@ -10,6 +10,9 @@
 //! * [`brdf_figures`]: the BRDF plots of `collect` (lit spheres, slices, albedo, validity).
 //! * [`html_report`]: the HTML report `collect` writes beside them.
 //! * [`heartbeat`]: plain progress lines when the output goes to a file.
+//! * [`slurm`]: the sweep as Slurm job arrays (requests, requeue on preemption, the collect
+//!   job, resubmission of failures).
+//! * [`status`]: where each run stands, read from the run directories (`sweep-status`).
 //! * [`timing`]: where a sweep's time went (its phases, each model's training and evaluation).
 //! * [`sources`]: mesh sources (embedded in the binary, under the data root) and real captures.
 //! * The profiles (`smoke`, `quick`, `runtime`, `full`, `real`, or a TOML file) mix generated
@@ -35,10 +38,12 @@ pub mod heartbeat;
 pub mod html_report;
 pub mod plan;
 pub mod profile;
+pub mod slurm;
 pub mod sources;
+pub mod status;
 pub mod timing;
 
 pub use collect::collect;
 pub use collected::CollectSummary;
-pub use execute::{Execution, SweepSummary, exit_with_parent, run_one, sweep};
+pub use execute::{Execution, RunEnd, SweepSummary, exit_with_parent, run_one, sweep};
 pub use profile::{DEFAULT_PROFILE, SweepProfile};
