@@ -84,6 +84,10 @@ pub fn cube_root_rmse(
 /// The noise ceiling of a scene, computed by the first evaluation of a run on it and kept in
 /// the cache directory: `ceiling-<key>.json`, the key hashing the scene's manifest checksum,
 /// whether LPIPS was scored and the code's results version.
+///
+/// One writer at a time: evaluations side by side (a sweep's `--jobs`, a cluster's tasks on a
+/// shared file system) that all miss the cache each compute the ceiling, but only the one that
+/// holds `ceiling-<key>.lock` ([`CeilingCache::claim`]) writes it.
 struct CeilingCache(std::path::PathBuf);
 
 impl CeilingCache {
@@ -96,6 +100,21 @@ impl CeilingCache {
     /// The cached ceiling; a missing or unreadable file is a miss (it is recomputed).
     fn read(&self) -> Option<ImageMetrics> {
         serde_json::from_str(&std::fs::read_to_string(&self.0).ok()?).ok()
+    }
+
+    /// The writer's lock (`None`: another evaluation holds it, and will write the ceiling),
+    /// held until the returned file drops.
+    fn claim(&self) -> Option<std::fs::File> {
+        let path = self.0.with_extension("lock");
+        std::fs::create_dir_all(self.0.parent()?).ok()?;
+        let file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(path)
+            .ok()?;
+        file.try_lock().ok().map(|()| file)
     }
 
     fn write(&self, ceiling: &ImageMetrics) -> Result<()> {
@@ -171,6 +190,7 @@ pub fn eval_fitted(
     };
     let cached = CeilingCache::new(&fitted.cache, dataset, lpips.is_some());
     let known = cached.read();
+    let writer = if known.is_none() { cached.claim() } else { None };
     let opts = images::RenderOptions {
         run,
         write: settings.images,
@@ -181,9 +201,10 @@ pub fn eval_fitted(
     let mut scores = images::render_and_score(dataset, &samples, &data, &pred, &opts)?;
     match (&known, &scores.ceiling) {
         (Some(c), _) => scores.ceiling = Some(c.clone()),
-        (None, Some(c)) => cached.write(c)?,
-        (None, None) => {}
+        (None, Some(c)) if writer.is_some() => cached.write(c)?,
+        (None, _) => {}
     }
+    drop(writer);
     charge(&mut phases.images);
     let brdf = ModelBrdf::new(model, &config.model, &data, device)?;
     let reciprocity_rmse = analyses::reciprocity(&brdf, &settings)?;
@@ -234,4 +255,20 @@ pub fn eval_fitted(
     all.test = Some(test.clone());
     all.write(&path)?;
     Ok(test)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::CeilingCache;
+
+    #[test]
+    fn one_evaluation_at_a_time_may_write_a_scenes_ceiling() {
+        let dir = test_support::TempDir::new("ceiling-claim");
+        let cache = CeilingCache(dir.0.join("cache/ceiling-0123.json"));
+        let first = cache.claim().expect("a free lock is claimed (its folder created)");
+        assert!(cache.claim().is_none(), "a second claim while the first holds it");
+        drop(first);
+        assert!(cache.claim().is_some(), "free again");
+        assert!(cache.read().is_none(), "claiming writes no ceiling");
+    }
 }

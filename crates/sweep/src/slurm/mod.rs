@@ -14,9 +14,10 @@
 //! its directory ([`crate::status`]), never from the scheduler.
 //!
 //! Shared-file-system safety: every task writes only inside its own run directory (atomically,
-//! under the run's lock); the scenes and caches are written before the first task starts and
-//! only read afterwards; `sweep.json` and the scripts are written by the submitting process
-//! alone. The run locks are `flock` locks, which hold across hosts where the file system
+//! under the run's lock); the scenes and LBO tables are written before the first task starts
+//! and only read afterwards; a scene's noise ceiling in the cache is written by the one
+//! evaluation that holds its lock; `sweep.json` and the scripts are written by the submitting
+//! process alone. The run locks are `flock` locks, which hold across hosts where the file system
 //! supports them (NFSv4, NFSv3 with its lock manager, Lustre mounted with `flock`).
 
 pub mod requests;
