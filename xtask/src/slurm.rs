@@ -35,6 +35,13 @@ pub fn print_submission(out: &Path, s: &Submission) {
     );
 }
 
+/// The sweep folder's lock, as `reproduce-tables` takes it: one process at a time writes its
+/// tables or its Slurm record.
+fn lock(out: &Path, what: &str) -> Result<stdx::lock::DirLock> {
+    stdx::lock::DirLock::acquire(out, what)
+        .with_context(|| format!("cannot {what} {}", out.display()))
+}
+
 /// `sweep-status DIR`: where each run stands, from the run directories.
 pub fn status(out: &Path) -> Result<()> {
     let runs = match SlurmSweep::read(out) {
@@ -49,6 +56,7 @@ pub fn status(out: &Path) -> Result<()> {
 /// `slurm-collect DIR` (the collect job): the tables and report of the finished runs, then the
 /// failed ones and the command that resubmits them. Exits with status 3 when a run is not done.
 pub fn collect(out: &Path) -> Result<()> {
+    let _lock = lock(out, "slurm-collect")?;
     let sweep = SlurmSweep::read(out)?;
     let status = sweep.status();
     if status.count("done") > 0 {
@@ -74,6 +82,7 @@ pub fn collect(out: &Path) -> Result<()> {
 /// `slurm-resubmit DIR`: submits the failed runs again (with `unfinished`, every run neither
 /// done nor running), with the settings of the first submission and a new collect job.
 pub fn resubmit(out: &Path, unfinished: bool, dry_run: bool) -> Result<()> {
+    let _lock = lock(out, "slurm-resubmit")?;
     let sweep = SlurmSweep::read(out)?;
     let todo = sweep::slurm::to_resubmit(&sweep.status(), unfinished);
     anyhow::ensure!(

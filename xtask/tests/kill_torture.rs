@@ -62,25 +62,12 @@ runtime_curve = true
 "#;
 
 /// The cheap torture of every CI run: one tiny scene, two models, the NOL ablation.
-const TINY: &str = r#"
-name = "tiny-torture"
-description = "kill -9 torture in CI: one tiny scene, two models"
-[data]
-meshes = ["embedded:spot"]
-materials = ["blue-acrylic"]
-size = 24
-views = 2
-lights = 4
-[run]
-seed = 3
-[run.model]
-width = 16
-[run.features.lbo]
-k_max = 32
-first = 16
-blocks = 1
-block_len = 8
-[run.train]
+fn tiny() -> String {
+    test_support::tiny_profile(
+        "tiny-torture",
+        "kill -9 torture in CI: one tiny scene, two models",
+        3,
+        r#"[run.train]
 profile = "quick"
 iterations = 60
 batch_size = 512
@@ -95,7 +82,9 @@ reciprocity_pairs = 200
 [sweep]
 models = ["disney", "single_mlp"]
 ablations = ["nol"]
-"#;
+"#,
+    )
+}
 
 /// A small deterministic generator (xorshift64*).
 struct Rng(u64);
@@ -392,7 +381,7 @@ fn kills(default: usize) -> usize {
 
 #[test]
 fn a_tiny_sweep_killed_five_times_resumes_to_the_same_results() {
-    torture(TINY, "tiny-torture", kills(5));
+    torture(&tiny(), "tiny-torture", kills(5));
 }
 
 #[test]

@@ -4,25 +4,12 @@
 
 use std::process::{Command, Stdio};
 
-const PROFILE: &str = r#"
-name = "lines"
-description = "progress lines: one tiny scene, two models"
-[data]
-meshes = ["embedded:spot"]
-materials = ["blue-acrylic"]
-size = 24
-views = 2
-lights = 4
-[run]
-seed = 1
-[run.model]
-width = 16
-[run.features.lbo]
-k_max = 32
-first = 16
-blocks = 1
-block_len = 8
-[run.train]
+fn tiny() -> String {
+    test_support::tiny_profile(
+        "lines",
+        "progress lines: one tiny scene, two models",
+        1,
+        r#"[run.train]
 iterations = 40
 batch_size = 512
 warmup_steps = 2
@@ -36,13 +23,15 @@ reciprocity_pairs = 200
 images = false
 [sweep]
 models = ["single_mlp", "disney"]
-"#;
+"#,
+    )
+}
 
 #[test]
 fn a_sweep_logging_to_a_file_prints_progress_lines() {
     let tmp = test_support::TempDir::new("progress-lines");
     let profile = tmp.0.join("lines.toml");
-    std::fs::write(&profile, PROFILE).unwrap();
+    std::fs::write(&profile, tiny()).unwrap();
     let log = tmp.0.join("sweep.log");
     let status = Command::new(env!("CARGO_BIN_EXE_xtask"))
         .args(["reproduce-tables", "--jobs", "2", "--profile"])

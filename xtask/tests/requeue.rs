@@ -10,25 +10,12 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-const PROFILE: &str = r#"
-name = "requeue"
-description = "SIGTERM test: one tiny scene, one model, 300 steps"
-[data]
-meshes = ["embedded:spot"]
-materials = ["blue-acrylic"]
-size = 24
-views = 2
-lights = 4
-[run]
-seed = 5
-[run.model]
-width = 16
-[run.features.lbo]
-k_max = 32
-first = 16
-blocks = 1
-block_len = 8
-[run.train]
+fn tiny() -> String {
+    test_support::tiny_profile(
+        "requeue",
+        "SIGTERM test: one tiny scene, one model, 300 steps",
+        5,
+        r#"[run.train]
 profile = "quick"
 iterations = 300
 batch_size = 512
@@ -43,7 +30,9 @@ reciprocity_pairs = 200
 [sweep]
 models = ["single_mlp"]
 ablations = []
-"#;
+"#,
+    )
+}
 
 fn xtask() -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_xtask"));
@@ -55,7 +44,7 @@ fn xtask() -> Command {
 /// Prepares the profile's one run under `out` (`--emit-jobs`: nothing trained) and returns it.
 fn prepare(root: &Path, out: &Path) -> PathBuf {
     let profile = root.join("requeue.toml");
-    std::fs::write(&profile, PROFILE).unwrap();
+    std::fs::write(&profile, tiny()).unwrap();
     let jobs = root.join("jobs.txt");
     let status = xtask()
         .args(["reproduce-tables", "--profile"])

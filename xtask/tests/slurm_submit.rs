@@ -10,30 +10,21 @@ use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-const PROFILE: &str = r#"
-name = "submit"
-description = "Slurm submission test: one tiny scene, three models"
-[data]
-meshes = ["embedded:spot"]
-materials = ["blue-acrylic"]
-size = 24
-views = 2
-lights = 4
-[run]
-seed = 1
-[run.features.lbo]
-k_max = 32
-first = 16
-blocks = 1
-block_len = 8
-[run.train]
+fn tiny() -> String {
+    test_support::tiny_profile(
+        "submit",
+        "Slurm submission test: one tiny scene, three models",
+        1,
+        r#"[run.train]
 profile = "quick"
 iterations = 100000
 batch_size = 512
 [sweep]
 models = ["single_mlp", "disney", "fmbrdf"]
 ablations = ["nol"]
-"#;
+"#,
+    )
+}
 
 fn executable(path: &Path, text: &str) {
     std::fs::write(path, text).unwrap();
@@ -63,7 +54,7 @@ fn fake_slurm(root: &Path, max: usize) -> PathBuf {
 
 fn submit(root: &Path, out: &Path, bin: &Path, extra: &[&str]) -> std::process::Output {
     let profile = root.join("submit.toml");
-    std::fs::write(&profile, PROFILE).unwrap();
+    std::fs::write(&profile, tiny()).unwrap();
     let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
     Command::new(env!("CARGO_BIN_EXE_xtask"))
         .env("PATH", path)

@@ -457,9 +457,12 @@ pub fn sweep(
     execute(&summary.runs.clone(), how, &mut summary)?;
     if let Execution::Slurm { program, backend, options } = how {
         let todo: Vec<PathBuf> = summary.runs.iter().filter(|d| !is_done(d)).cloned().collect();
-        let first = (profile.name.as_str(), program.as_str(), backend.name());
-        summary.submission =
-            Some(crate::slurm::submit(out, &summary.runs, &todo, Some(first), options)?);
+        // Nothing left to run: no job is submitted, and the tables are made here.
+        if !todo.is_empty() {
+            let first = (profile.name.as_str(), program.as_str(), backend.name());
+            summary.submission =
+                Some(crate::slurm::submit(out, &summary.runs, &todo, Some(first), options)?);
+        }
     }
     summary.seconds = start.elapsed().as_secs_f64();
     if !matches!(how, Execution::Emit { .. } | Execution::Slurm { .. }) {

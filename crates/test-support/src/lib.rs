@@ -1,13 +1,16 @@
 //! Helpers shared by the tests of every crate (taken as a dev-dependency, never by library code):
 //! where the shared dataset and documents live ([`shared_data_root`], [`shared_docs_root`]), fresh temporary directories
 //! ([`TempDir`]), corrupted copies of real files for the loaders' robustness tests
-//! ([`corrupt`]), and adversarial directions and features for the numerics stress tests
-//! ([`adversarial`]).
+//! ([`corrupt`]), adversarial directions and features for the numerics stress tests
+//! ([`adversarial`]), and the tiny sweep profile of the tests that run whole sweeps
+//! ([`tiny_profile`]).
 
 pub mod adversarial;
 pub mod corrupt;
+mod profile;
 mod shared_data;
 mod temp_dir;
 
+pub use profile::tiny_profile;
 pub use shared_data::{shared_data_root, shared_docs_root};
 pub use temp_dir::TempDir;

@@ -161,7 +161,10 @@ pub fn submit(
     first: Option<(&str, &str, &str)>,
     options: &SlurmOptions,
 ) -> Result<Submission> {
+    let recorded = SlurmSweep::path(out).exists();
     let mut sweep = match SlurmSweep::read(out) {
+        // A record that cannot be read is not replaced: its job ids would be lost.
+        Err(e) if recorded => return Err(e),
         Ok(mut s) => {
             if !all.is_empty() {
                 s.runs = absolute_all(all)?;
