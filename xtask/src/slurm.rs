@@ -29,7 +29,7 @@ pub fn print_submission(out: &Path, s: &Submission) {
         s.collect_job.as_deref().unwrap_or("-"),
         s.collect_script.display()
     );
-    let out = sweep::execute::shell_quote(&out.display().to_string());
+    let out = sweep::shell::quote(&out.display().to_string());
     eprintln!(
         "follow it with `cargo xtask sweep-status {out}` (or squeue); the tables land in {out}/tables"
     );

@@ -10,6 +10,7 @@
 use super::heartbeat::Heartbeat;
 use super::plan::{self, Purpose, RunInfo, RunSpec, SceneSource, SceneSpec};
 use super::profile::{CaptureSource, SweepProfile, resolve_mesh};
+use super::shell;
 use super::timing::SweepTiming;
 use brdf_neural::device::Backend;
 use dataset_merl::generate_scene;
@@ -382,8 +383,8 @@ pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) ->
             let mut text = String::new();
             for d in &todo {
                 let abs = std::path::absolute(d).map_err(|e| Error::io(d, e))?;
-                let mut parts: Vec<String> = command.iter().map(|c| shell_quote(c)).collect();
-                parts.push(shell_quote(&abs.display().to_string()));
+                let mut parts: Vec<String> = command.iter().map(|c| shell::quote(c)).collect();
+                parts.push(shell::quote(&abs.display().to_string()));
                 text.push_str(&parts.join(" "));
                 text.push('\n');
             }
@@ -417,15 +418,6 @@ fn last_error(log: &Path) -> String {
 
 fn short(d: &Path) -> String {
     d.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
-}
-
-/// Quotes a word for POSIX shells when needed.
-pub fn shell_quote(s: &str) -> String {
-    if !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || "-_./=:+@%".contains(c)) {
-        s.to_string()
-    } else {
-        format!("'{}'", s.replace('\'', "'\\''"))
-    }
 }
 
 /// Plans, prepares and executes a whole sweep into `out`.
@@ -480,17 +472,4 @@ pub fn sweep(
         }
     }
     Ok(summary)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn shell_words_are_quoted() {
-        assert_eq!(shell_quote("/a/b-c_d.e"), "/a/b-c_d.e");
-        assert_eq!(shell_quote("a b"), "'a b'");
-        assert_eq!(shell_quote("it's"), "'it'\\''s'");
-        assert_eq!(shell_quote(""), "''");
-    }
 }

@@ -12,6 +12,7 @@
 //! * [`heartbeat`]: plain progress lines when the output goes to a file.
 //! * [`slurm`]: the sweep as Slurm job arrays (requests, requeue on preemption, the collect
 //!   job, resubmission of failures).
+//! * [`shell`]: quoting the words of job files and scripts.
 //! * [`status`]: where each run stands, read from the run directories (`sweep-status`).
 //! * [`timing`]: where a sweep's time went (its phases, each model's training and evaluation).
 //! * [`sources`]: mesh sources (embedded in the binary, under the data root) and real captures.
@@ -38,6 +39,7 @@ pub mod heartbeat;
 pub mod html_report;
 pub mod plan;
 pub mod profile;
+pub mod shell;
 pub mod slurm;
 pub mod sources;
 pub mod status;

@@ -358,7 +358,7 @@ fn sbatch(script: &Path, extra: &[String], dry_run: bool) -> Result<Option<Strin
         words.push(script.display().to_string());
         eprintln!(
             "  (dry run) {}",
-            words.iter().map(|w| crate::execute::shell_quote(w)).collect::<Vec<_>>().join(" ")
+            words.iter().map(|w| crate::shell::quote(w)).collect::<Vec<_>>().join(" ")
         );
         return Ok(None);
     }
@@ -417,7 +417,7 @@ pub fn failure_report(out: &Path, status: &SweepStatus) -> Option<String> {
             f.message.lines().next().unwrap_or(""),
         ));
     }
-    let out = crate::execute::shell_quote(&out.display().to_string());
+    let out = crate::shell::quote(&out.display().to_string());
     if failed.is_empty() {
         text.push_str(&format!(
             "no run failed, {not_done} not done; to send those again: cargo xtask slurm-resubmit {out} --unfinished\n"

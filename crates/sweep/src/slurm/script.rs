@@ -9,7 +9,7 @@
 //! task. A run stopped that way exits with [`experiments::interrupt::EXIT_REQUEUE`].
 
 use super::requests::Requests;
-use crate::execute::shell_quote;
+use crate::shell::quote as shell_quote;
 use std::path::Path;
 
 /// What every script of a submission shares.
