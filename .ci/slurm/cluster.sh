@@ -12,7 +12,10 @@ cluster_install() {
     local packages="slurm-wlm munge"
     { apt-get install -y -qq --no-install-recommends $packages ||
         { apt-get update -qq && apt-get install -y -qq --no-install-recommends $packages; }; } \
-        >/dev/null
+        >/dev/null || {
+        echo "ci: could not install $packages with apt-get (root and Debian's archive are needed)" >&2
+        return 1
+    }
 }
 
 cluster_up() {
