@@ -42,7 +42,7 @@
 #   3. the baseline: the previous build's training step (`.devrun_old/bin.tar.xz`, when
 #      carried: burn's wgpu without autotune, fusion or the batch split), same machine;
 #   4. the training step at batch 32,768, three model kinds on wgpu, without and with the batch
-#      split (`brdf_neural::split_k`), one layer's products alone, and the Single MLP back to
+#      split (`brdf_neural::batch_split`), one layer's products alone, and the Single MLP back to
 #      back with PyTorch on CUDA (f32, three rounds);
 #   5. where a step's GPU time goes: CubeCL's kernel profile of Single MLP steps, summed by kernel;
 #   6. the step on the machine's CPU cores (flex), without and with the batch split.
@@ -221,7 +221,7 @@ if [ "$STAGE" = loop ]; then
     # The training loop's host round trips (item 2 of the throughput issue): the default run's
     # Single MLP and FMBRDF for the 1,400 steps of the converged CPU fit, reading the loss
     # every step (NEURAL_BRDF_LOSS_READS=1, the loop before the loss windows) and every 100
-    # steps (the GPU's default, `experiments::trainer::GPU_LOSS_READS`), alternately, with
+    # steps (the GPU's default, `experiments::train_loop::GPU_LOSS_READS`), alternately, with
     # `nvidia-smi dmon` sampling the SM use every second (the log marks where each run starts).
     # The four runs are separate processes sharing one fresh persistent GPU cache
     # (brdf_neural::gpu_cache): the first pays autotune and kernel compilation in its warm-up

@@ -2,7 +2,7 @@
 //! command (see the `sweep` crate for the profiles, the run layout and the tables).
 
 use anyhow::{Context, Result};
-use experiments::{Backend, MatmulPrecision};
+use experiments::{Backend, BackendDevice, MatmulPrecision};
 use run_format::run_dir::SweepLayout;
 use std::path::{Path, PathBuf};
 use sweep::{Execution, SweepProfile};

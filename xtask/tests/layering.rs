@@ -68,3 +68,29 @@ fn every_member_is_in_the_layering_once() {
     assert_eq!(unique.len(), layers.len(), "a crate listed twice: {layers:?}");
     assert_eq!(layers.len(), members, "layering {layers:?} against {members} members");
 }
+
+/// The normal (non-dev) dependency tree of `package`, one crate name a line.
+fn normal_tree(package: &str) -> Vec<String> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = Command::new(cargo)
+        .args(["tree", "-p", package, "-e", "normal", "--prefix", "none", "--offline"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("run cargo tree");
+    assert!(out.status.success(), "cargo tree failed: {}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).expect("UTF-8");
+    text.lines().filter_map(|l| l.split_whitespace().next()).map(str::to_owned).collect()
+}
+
+/// The on-disk format of a run is read by tools that train nothing (the report, the sweep's
+/// collectors, users' scripts): it must build without the tensor stack.
+#[test]
+fn run_format_and_report_build_without_burn() {
+    for package in ["run-format", "report", "model-spec"] {
+        let tree = normal_tree(package);
+        assert!(tree.iter().any(|c| c == package), "{package} missing from its own tree");
+        let tensor: Vec<&String> =
+            tree.iter().filter(|c| c.starts_with("burn") || c.starts_with("cubecl")).collect();
+        assert!(tensor.is_empty(), "{package} builds {tensor:?}");
+    }
+}

@@ -13,6 +13,11 @@
 //! visible normals, Phong and GTR1 lobes) and the lobe mixture live in [`sampling`]; each model's
 //! parameter table says which strategy it uses.
 //!
+//! A fitted material over a surface, analytic or neural, is a [`SurfaceBrdf`]: a batched
+//! f(x, l, v) over surface points, which every [`Brdf`] is (spatially uniform) and which
+//! `brdf-neural` implements for its models; validation, evaluation, export and the metrics take
+//! it.
+//!
 //! Conventions every model keeps (architecture invariants):
 //! * evaluating never fails, never allocates and never returns NaN or Inf: outside the upper
 //!   hemisphere (n.l <= 0 or n.v <= 0) it returns 0, and parameters are validated or clamped
@@ -68,6 +73,7 @@ mod params;
 mod phong;
 pub mod quadrature;
 pub mod sampling;
+mod surface;
 mod torrance_sparrow;
 
 pub use angles::{Real, Vec3};
@@ -88,4 +94,5 @@ pub use fmbrdf::{Fmbrdf, FmbrdfParams};
 pub use lambert::{Lambert, LambertParams};
 pub use params::ParamError;
 pub use phong::{RealisticPhong, RealisticPhongParams};
+pub use surface::{FnSurface, SurfaceBrdf};
 pub use torrance_sparrow::{TorranceSparrow, TorranceSparrowParams};

@@ -24,8 +24,8 @@
 //!   products ([`brdf_neural::precision`], flex and cuda: tensor cores), with the PyTorch
 //!   comparison under bf16 autocast, and the flex products themselves in both precisions;
 //! - `BRDF_BENCH_SPLIT=1,64` times every step with its linear layers' batch split into these
-//!   numbers of parts ([`brdf_neural::split_k`]; default: what the trainer uses, 1 on the
-//!   CPU and [`brdf_neural::split_k::gpu_parts`] on a GPU), and, on a GPU backend, prints
+//!   numbers of parts ([`brdf_neural::batch_split`]; default: what the trainer uses, 1 on the
+//!   CPU and [`brdf_neural::batch_split::gpu_parts`] on a GPU), and, on a GPU backend, prints
 //!   the times of one 128-wide layer's three products alone (forward, input gradient, weight
 //!   gradient plain and split).
 //!
@@ -37,10 +37,12 @@
 //!
 //! Dated figures, the first (2026-11-21, 2-core AMD EPYC) included, are in benches/README.md.
 
+use brdf_neural::batch_split;
 use brdf_neural::device::Backend;
+use brdf_neural::device::BackendDevice;
 use brdf_neural::mlp::MlpConfig;
 use brdf_neural::precision::MatmulPrecision;
-use brdf_neural::split_k;
+use brdf_neural::precision::PrecisionScope;
 use brdf_neural::{BrdfBatch, BrdfModel, ModelConfig, ModelKind, Reciprocity, Samples};
 use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
 use burn::tensor::{Device, Distribution, Tensor};
@@ -53,8 +55,10 @@ fn batch_size() -> usize {
 
 fn backends() -> Vec<Backend> {
     match std::env::var("BRDF_BENCH_BACKENDS") {
-        Ok(s) => s.split(',').map(|b| Backend::parse(b).expect("backend")).collect(),
-        Err(_) => Backend::available().into_iter().filter(|b| !b.is_gpu()).collect(),
+        Ok(s) => {
+            s.split(',').map(|b| brdf_neural::device::parse_backend(b).expect("backend")).collect()
+        }
+        Err(_) => brdf_neural::device::available().into_iter().filter(|b| !b.is_gpu()).collect(),
     }
 }
 
@@ -99,7 +103,7 @@ struct Step {
     device: Device,
     backend: Backend,
     precision: MatmulPrecision,
-    /// Parts the linear layers' batch is split into ([`split_k`]).
+    /// Parts the linear layers' batch is split into ([`batch_split`]).
     split: usize,
 }
 
@@ -148,7 +152,7 @@ impl Step {
     /// Forward, radiance L = f * (E shadow cos), MSE, backward, Adam; waits for the device.
     fn run(&mut self) {
         let _precision = self.precision.scope(self.backend).expect("precision on this backend");
-        let _split = split_k::scope(self.split);
+        let _split = batch_split::scope(self.split);
         let model = self.model.take().expect("model");
         let out = model.forward(&self.batch);
         let loss = (out.f * self.weight.clone() - self.target.clone()).square().mean();
@@ -433,7 +437,7 @@ fn bench(cr: &mut Criterion) {
         );
     }
     if backends().into_iter().any(|b| b.is_gpu()) {
-        // On a GPU whose layers run on gpu-kernels, `split_k` leaves the layers whole.
+        // On a GPU whose layers run on gpu-kernels, `batch_split` leaves the layers whole.
         use brdf_neural::gpu_linear::GpuLinear;
         let layers = match GpuLinear::current() {
             GpuLinear::Ours => {
@@ -500,7 +504,7 @@ fn splits(backend: Backend, n: usize) -> Vec<usize> {
 
 /// The split the trainer uses on `backend` for a batch of `n`.
 fn default_split(backend: Backend, n: usize) -> usize {
-    if backend.is_gpu() { split_k::gpu_parts(n) } else { 1 }
+    if backend.is_gpu() { batch_split::gpu_parts(n) } else { 1 }
 }
 
 /// Prints the times of one 128-wide layer's products at batch `n` on `backend` (a GPU):

@@ -1,8 +1,9 @@
 //! Run-time choice of the burn backend: the only place in the crate that names one.
 //!
 //! Models, batches and the tensor BRDFs take a [`Device`]; which backend runs them is decided
-//! here, from cargo features and, at run time, from [`Backend`] (parsed from the `--backend`
-//! flag of `fit`/`eval` and `reproduce-tables`).
+//! here, from cargo features and, at run time, from [`Backend`] (model-spec's names, parsed by
+//! [`parse_backend`] from the `--backend` flag of `fit`/`eval` and `reproduce-tables`), through
+//! [`BackendDevice`].
 //!
 //! | backend | `--backend` | cargo feature | default | notes |
 //! | --- | --- | --- | --- | --- |
@@ -25,37 +26,30 @@
 //! with the opt-in `x86-v4` feature of this crate (and still selected at run time).
 
 use burn::tensor::Device;
-use serde::{Deserialize, Serialize};
 
-/// A burn backend this crate can be built with.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Backend {
-    /// burn-flex, pure Rust, CPU (feature `flex`, on by default).
-    Flex,
-    /// burn-ndarray, CPU (feature `ndarray`).
-    NdArray,
-    /// burn-wgpu, GPU (feature `wgpu`).
-    Wgpu,
-    /// CubeCL's CUDA runtime, NVIDIA GPUs (feature `cuda`).
-    Cuda,
-}
+/// The backends' names (model-spec's, so that a run's records need no tensor library).
+pub use model_spec::Backend;
 
-impl Default for Backend {
-    /// The default CPU backend: flex when built, else ndarray.
-    fn default() -> Self {
-        if cfg!(feature = "flex") || !cfg!(feature = "ndarray") {
-            Backend::Flex
-        } else {
-            Backend::NdArray
-        }
+/// The build's default CPU backend: flex when built, else ndarray (what `cpu` means).
+pub fn default_backend() -> Backend {
+    if cfg!(feature = "flex") || !cfg!(feature = "ndarray") {
+        Backend::Flex
+    } else {
+        Backend::NdArray
     }
 }
 
-impl std::fmt::Display for Backend {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
+/// Parses a backend name: `cpu` ([`default_backend`]), `flex`, `ndarray`, `wgpu` or `cuda`
+/// (case-insensitive). A backend that is not built in parses; [`BackendDevice::device`]
+/// refuses it.
+pub fn parse_backend(name: &str) -> crate::Result<Backend> {
+    Backend::parse_with(name, default_backend())
+        .map_err(|_| crate::Error::UnknownBackend(name.into()))
+}
+
+/// The backends compiled into this build, default first.
+pub fn available() -> Vec<Backend> {
+    Backend::ALL.into_iter().filter(|b| b.is_built()).collect()
 }
 
 /// Whether `x` lives on a GPU (a CubeCL device: `wgpu` or `cuda`).
@@ -68,17 +62,18 @@ pub fn on_gpu<const D: usize>(x: &burn::tensor::Tensor<D>) -> bool {
     false
 }
 
-impl Backend {
-    /// Every backend, built or not.
-    pub const ALL: [Backend; 4] = [Backend::Flex, Backend::NdArray, Backend::Wgpu, Backend::Cuda];
-
-    /// The backends compiled into this build, default first.
-    pub fn available() -> Vec<Backend> {
-        Self::ALL.into_iter().filter(|b| b.is_built()).collect()
-    }
-
+/// What this build does with a [`Backend`]: whether it is built in, and its devices.
+pub trait BackendDevice {
     /// Whether this backend's cargo feature is on in this build.
-    pub fn is_built(self) -> bool {
+    fn is_built(self) -> bool;
+    /// The inference device of this backend, or an error if it was not compiled in.
+    fn device(self) -> crate::Result<Device>;
+    /// The training device of this backend (the inference device with autodiff).
+    fn training_device(self) -> crate::Result<Device>;
+}
+
+impl BackendDevice for Backend {
+    fn is_built(self) -> bool {
         match self {
             Backend::Flex => cfg!(feature = "flex"),
             Backend::NdArray => cfg!(feature = "ndarray"),
@@ -87,41 +82,11 @@ impl Backend {
         }
     }
 
-    /// Whether the backend runs on a GPU.
-    pub fn is_gpu(self) -> bool {
-        matches!(self, Backend::Wgpu | Backend::Cuda)
-    }
-
-    /// The name [`Backend::parse`] reads (and `metrics.json` records).
-    pub fn name(self) -> &'static str {
-        match self {
-            Backend::Flex => "flex",
-            Backend::NdArray => "ndarray",
-            Backend::Wgpu => "wgpu",
-            Backend::Cuda => "cuda",
-        }
-    }
-
-    /// Parses `cpu` (the default CPU backend), `flex`, `ndarray`, `wgpu` or `cuda`
-    /// (case-insensitive). A backend that is not built in parses; [`Backend::device`] refuses it.
-    pub fn parse(name: &str) -> crate::Result<Backend> {
-        match name.to_ascii_lowercase().as_str() {
-            "cpu" => Ok(Backend::default()),
-            "flex" => Ok(Backend::Flex),
-            "ndarray" => Ok(Backend::NdArray),
-            "wgpu" => Ok(Backend::Wgpu),
-            "cuda" => Ok(Backend::Cuda),
-            _ => Err(crate::Error::UnknownBackend(name.to_string())),
-        }
-    }
-
-    /// The inference device of this backend, or an error if it was not compiled in.
-    ///
     /// The CPU backends first apply the process's host-memory policy
     /// ([`host_memory::keep_freed_tensor_memory`](crate::host_memory::keep_freed_tensor_memory)).
     /// A GPU device is made lazily: a machine without one fails at its first tensor operation.
     #[allow(unreachable_code)]
-    pub fn device(self) -> crate::Result<Device> {
+    fn device(self) -> crate::Result<Device> {
         match self {
             Backend::Flex => {
                 #[cfg(feature = "flex")]
@@ -168,8 +133,7 @@ impl Backend {
         Err(crate::Error::BackendNotBuilt(self))
     }
 
-    /// The training device of this backend (the inference device with autodiff).
-    pub fn training_device(self) -> crate::Result<Device> {
+    fn training_device(self) -> crate::Result<Device> {
         Ok(self.device()?.autodiff())
     }
 }
@@ -217,7 +181,7 @@ pub fn is_cpu_device(device: &Device) -> bool {
 /// # Panics
 /// If the crate was built without any CPU backend feature.
 pub fn cpu() -> Device {
-    Backend::default()
+    default_backend()
         .device()
         .expect("brdf-neural built without a CPU backend (enable `flex` or `ndarray`)")
 }
@@ -234,12 +198,12 @@ mod tests {
     #[test]
     fn names_round_trip_and_cpu_means_the_default() {
         for b in Backend::ALL {
-            assert_eq!(Backend::parse(b.name()).unwrap(), b);
-            assert_eq!(Backend::parse(&b.name().to_uppercase()).unwrap(), b);
+            assert_eq!(parse_backend(b.name()).unwrap(), b);
+            assert_eq!(parse_backend(&b.name().to_uppercase()).unwrap(), b);
         }
-        assert_eq!(Backend::parse("cpu").unwrap(), Backend::default());
-        assert!(Backend::parse("metal").is_err());
-        assert!(Backend::available().contains(&Backend::default()));
+        assert_eq!(parse_backend("cpu").unwrap(), default_backend());
+        assert!(parse_backend("metal").is_err());
+        assert!(available().contains(&default_backend()));
         assert!(is_cpu_device(&cpu()));
         assert!(is_cpu_device(&cpu_training()));
     }

@@ -29,6 +29,9 @@ pub enum Error {
     /// Sample arrays whose lengths disagree.
     #[error("batch shape: {0}")]
     BatchShape(String),
+    /// A model output that could not be read back from the device as f32.
+    #[error("cannot read the model's output back: {0}")]
+    Readback(String),
 }
 
 /// `Result` with this crate's [`Error`].

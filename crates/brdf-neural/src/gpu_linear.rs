@@ -3,7 +3,7 @@
 //! | value of `NEURAL_BRDF_GPU_LINEAR` | kernels |
 //! | --- | --- |
 //! | `ours` (the default) | this workspace's `gpu-kernels`: a tiled product with the bias fused, the weight gradient split over the batch inside its kernel and its parts added in a fixed order, through the same backend extension as the CPU kernels ([`crate::linear_op`]) |
-//! | `burn` | burn's: CubeCL's autotuned matrix product; the trainer splits the batch ([`crate::split_k`]) so that autodiff splits the weight gradients |
+//! | `burn` | burn's: CubeCL's autotuned matrix product; the trainer splits the batch ([`crate::batch_split`]) so that autodiff splits the weight gradients |
 //!
 //! The choice is per process (the environment is read once). An unknown value is refused when a
 //! GPU device is made ([`crate::device::Backend::device`]), naming the variable. `ours` is the

@@ -12,7 +12,7 @@
 //! [`keep_freed_tensor_memory`] raises both thresholds once per process (`mallopt`), so freed
 //! buffers return to malloc's free lists and the next step reuses them. The price is that the
 //! process keeps its peak heap (about the memory of one training step) until it exits. It runs
-//! when a CPU device is first made through [`Backend::device`](crate::device::Backend::device)
+//! when a CPU device is first made through [`BackendDevice::device`](crate::device::BackendDevice::device)(crate::device::Backend::device)
 //! and does nothing on other C libraries (musl, macOS, Windows), whose allocators behave
 //! differently. `BRDF_KEEP_MALLOC=0` in the environment turns it off, for comparisons.
 

@@ -35,6 +35,9 @@
 //! [`ModelConfig::mlp_configs`]). This crate builds the models from them:
 //! [`BrdfModel::init`] and [`BrdfModel::init_seeded`], batches with [`BrdfBatch::new`] (and
 //! [`BrdfBatch::from_owned`], [`BrdfBatch::from_table`], [`BrdfBatch::from_records`]).
+//! A fitted model over surface points is [`fitted`]: its predictions on records, the inputs
+//! kept on the device, and the model as a [`brdf_analytic::SurfaceBrdf`]
+//! ([`fitted::NeuralSurface`]).
 //!
 //! # Parameter counts
 //!
@@ -68,9 +71,11 @@ pub mod device;
 mod error;
 // The direction features, defined in model-spec, under their old path.
 pub use model_spec::features;
+pub mod batch_split;
 #[cfg(any(feature = "wgpu", feature = "cuda"))]
 mod cube_linear;
 pub mod finite_check;
+pub mod fitted;
 #[cfg(feature = "flex")]
 mod flex_linear;
 pub mod gpu_cache;
@@ -86,7 +91,6 @@ pub mod parametric;
 pub mod precision;
 pub mod record_table;
 pub mod single_mlp;
-pub mod split_k;
 pub mod tensor_brdf;
 
 pub use batch::{BrdfBatch, SPATIAL_LIMIT, Samples, SpatialTable};

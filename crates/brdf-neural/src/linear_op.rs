@@ -21,7 +21,7 @@ use burn::tensor::Tensor;
 pub use kernels::LinearKernels;
 
 /// `x W + b` for x `[rows, d_in]`, W `[d_in, d_out]`, b `[d_out]`, its products in `precision`
-/// on the flex backend (f32 elsewhere: [`MatmulPrecision::scope`] refuses bf16 on other
+/// on the flex backend (f32 elsewhere: [`PrecisionScope::scope`](crate::precision::PrecisionScope::scope) refuses bf16 on other
 /// backends); burn's `linear` on every other backend.
 pub fn linear(
     x: Tensor<2>,

@@ -6,11 +6,11 @@
 //! A concatenation [h, x] followed by a linear layer equals W_h h + W_x x + b; that is how it
 //! is computed here (two matrix products, no copy), with the same parameter count.
 //!
-//! Every linear layer runs through [`crate::split_k`], which splits the batch sum of the
+//! Every linear layer runs through [`crate::batch_split`], which splits the batch sum of the
 //! weight gradients into parts on GPU backends.
 
+use crate::batch_split::linear;
 use crate::linear_op::relu;
-use crate::split_k::linear;
 use burn::module::Module;
 use burn::nn::{Linear, LinearConfig};
 use burn::tensor::{Device, Tensor};

@@ -10,43 +10,28 @@
 //! tensor cores (`gpu-kernels`' `gemm_cmma`), PyTorch's bf16 autocast for the linear layers.
 //! The flex and cuda backends implement it; the others refuse it.
 //!
-//! The setting belongs to the training loop of one thread: [`MatmulPrecision::scope`] applies
+//! The setting belongs to the training loop of one thread: [`PrecisionScope::scope`](crate::precision::PrecisionScope::scope) applies
 //! it to the linear layers of the models that thread runs until the returned guard drops, so an
-//! evaluation on another thread (or after the fit) keeps f32; [`MatmulPrecision::f32_scope`]
+//! evaluation on another thread (or after the fit) keeps f32; [`PrecisionScope::f32_scope`](crate::precision::PrecisionScope::f32_scope)
 //! returns to f32 inside a bf16 scope (the training loop's validation loss, which decides the
-//! plateau schedule, is f32). The layers read it when they run ([`MatmulPrecision::current`])
+//! plateau schedule, is f32). The layers read it when they run ([`PrecisionScope::current`](crate::precision::PrecisionScope::current))
 //! and hand it to the kernels as an argument of each product ([`crate::linear_op`]), which keep
 //! it for the product's backward pass; no other matrix product in the process is affected.
 //! Products that gain nothing (narrow heads such as the 3-channel output, small products) stay
 //! f32.
 
-use serde::{Deserialize, Serialize};
 use std::cell::Cell;
 
 thread_local! {
     static CURRENT: Cell<MatmulPrecision> = const { Cell::new(MatmulPrecision::F32) };
 }
 
-/// How the f32 matrix products of a training step are computed.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum MatmulPrecision {
-    /// f32 operands, f32 sums (the default).
-    #[default]
-    F32,
-    /// Operands rounded to bf16, products summed in f32.
-    Bf16,
-}
+/// The precisions' names (model-spec's, so that a run's configuration needs no tensor library).
+pub use model_spec::MatmulPrecision;
 
-impl MatmulPrecision {
-    /// The config and command-line spelling.
-    pub fn name(self) -> &'static str {
-        match self {
-            MatmulPrecision::F32 => "f32",
-            MatmulPrecision::Bf16 => "bf16",
-        }
-    }
-
+/// What this crate does with a [`MatmulPrecision`]: applies it to the calling thread's
+/// products ([`PrecisionScope::scope`]) and says what the CPU runs natively.
+pub trait PrecisionScope {
     /// Applies this precision to the matrix products the calling thread issues on `backend`
     /// until the guard drops.
     ///
@@ -54,7 +39,37 @@ impl MatmulPrecision {
     /// [`crate::Error::Spec`] (an invalid configuration) for bf16 on a backend other than flex
     /// and cuda, and on cuda with burn's kernels for the linear layers
     /// (`NEURAL_BRDF_GPU_LINEAR=burn`, [`crate::gpu_linear`]).
-    pub fn scope(self, backend: crate::device::Backend) -> crate::Result<PrecisionGuard> {
+    fn scope(self, backend: crate::device::Backend) -> crate::Result<PrecisionGuard>;
+
+    /// Plain f32 products on the calling thread until the guard drops, whatever was set before
+    /// (a training loop's validation loss and other measurements inside a bf16 scope).
+    fn f32_scope() -> PrecisionGuard;
+
+    /// The precision of the linear layers the calling thread runs now (f32 outside a
+    /// [`PrecisionScope::scope`](crate::precision::PrecisionScope::scope)).
+    fn current() -> MatmulPrecision;
+
+    /// Whether this CPU has Intel's AMX-BF16 tile unit (Xeons from Sapphire Rapids on; CPUID
+    /// leaf 7, EDX bit 22). The flex backend's bf16 products run on it when Linux grants the
+    /// tile registers ([`PrecisionScope::bf16_on_amx`](crate::precision::PrecisionScope::bf16_on_amx)); without it they take the AVX512-BF16
+    /// kernel, measured slower than f32 on such a Xeon (`benches/README.md`, "bf16 on an Intel
+    /// Xeon with AMX"), and the trainer warns.
+    fn cpu_has_amx_bf16() -> bool;
+
+    /// Whether the bf16 products run on AMX tiles here (the flex backend's AMX kernel: the CPU
+    /// has AMX-BF16 and Linux granted the tile registers; `CPU_KERNELS_AMX=0` turns it off).
+    fn bf16_on_amx() -> bool;
+
+    /// Lets the bf16 products use AMX tiles where available (the default) or keeps them on the
+    /// AVX-512 kernel, process-wide: for benchmarks and tests that compare the two.
+    fn set_bf16_amx_enabled(enabled: bool);
+
+    /// Whether this CPU runs bf16 products natively (otherwise they are emulated, slowly).
+    fn bf16_native() -> bool;
+}
+
+impl PrecisionScope for MatmulPrecision {
+    fn scope(self, backend: crate::device::Backend) -> crate::Result<PrecisionGuard> {
         use crate::device::Backend;
         use crate::gpu_linear::GpuLinear;
         if self == MatmulPrecision::F32 {
@@ -86,24 +101,15 @@ impl MatmulPrecision {
         }
     }
 
-    /// Plain f32 products on the calling thread until the guard drops, whatever was set before
-    /// (a training loop's validation loss and other measurements inside a bf16 scope).
-    pub fn f32_scope() -> PrecisionGuard {
+    fn f32_scope() -> PrecisionGuard {
         PrecisionGuard { previous: Some(set(MatmulPrecision::F32)) }
     }
 
-    /// The precision of the linear layers the calling thread runs now (f32 outside a
-    /// [`MatmulPrecision::scope`]).
-    pub fn current() -> MatmulPrecision {
+    fn current() -> MatmulPrecision {
         CURRENT.with(Cell::get)
     }
 
-    /// Whether this CPU has Intel's AMX-BF16 tile unit (Xeons from Sapphire Rapids on; CPUID
-    /// leaf 7, EDX bit 22). The flex backend's bf16 products run on it when Linux grants the
-    /// tile registers ([`MatmulPrecision::bf16_on_amx`]); without it they take the AVX512-BF16
-    /// kernel, measured slower than f32 on such a Xeon (`benches/README.md`, "bf16 on an Intel
-    /// Xeon with AMX"), and the trainer warns.
-    pub fn cpu_has_amx_bf16() -> bool {
+    fn cpu_has_amx_bf16() -> bool {
         #[cfg(target_arch = "x86_64")]
         {
             use std::arch::x86_64::{__cpuid, __cpuid_count};
@@ -115,9 +121,7 @@ impl MatmulPrecision {
         }
     }
 
-    /// Whether the bf16 products run on AMX tiles here (the flex backend's AMX kernel: the CPU
-    /// has AMX-BF16 and Linux granted the tile registers; `CPU_KERNELS_AMX=0` turns it off).
-    pub fn bf16_on_amx() -> bool {
+    fn bf16_on_amx() -> bool {
         #[cfg(feature = "flex")]
         {
             cpu_kernels::bf16_amx_active()
@@ -128,17 +132,14 @@ impl MatmulPrecision {
         }
     }
 
-    /// Lets the bf16 products use AMX tiles where available (the default) or keeps them on the
-    /// AVX-512 kernel, process-wide: for benchmarks and tests that compare the two.
-    pub fn set_bf16_amx_enabled(enabled: bool) {
+    fn set_bf16_amx_enabled(enabled: bool) {
         #[cfg(feature = "flex")]
         cpu_kernels::set_bf16_amx_enabled(enabled);
         #[cfg(not(feature = "flex"))]
         let _ = enabled;
     }
 
-    /// Whether this CPU runs bf16 products natively (otherwise they are emulated, slowly).
-    pub fn bf16_native() -> bool {
+    fn bf16_native() -> bool {
         #[cfg(feature = "flex")]
         {
             cpu_kernels::bf16_dot_native()
@@ -170,7 +171,7 @@ fn set(p: MatmulPrecision) -> MatmulPrecision {
 
 #[cfg(test)]
 mod tests {
-    use super::MatmulPrecision;
+    use super::{MatmulPrecision, PrecisionScope};
 
     /// The CPUID bit agrees with the kernel's own reading of it (Linux's `amx_bf16` flag).
     #[test]

@@ -12,6 +12,7 @@
 
 use brdf_neural::device;
 use burn::tensor::{Tensor, TensorData};
+use test_support::assert_close;
 
 /// Deterministic values in [-1, 1).
 fn values(n: usize, seed: u64) -> Vec<f32> {
@@ -40,13 +41,6 @@ fn reference(a: &[f32], b: &[f32], m: usize, k: usize, n: usize) -> Vec<f64> {
     c
 }
 
-fn assert_close(got: &[f32], want: &[f64], what: &str) {
-    assert_eq!(got.len(), want.len(), "{what}: length");
-    for (i, (g, w)) in got.iter().zip(want).enumerate() {
-        assert!((f64::from(*g) - w).abs() <= 1e-4 * (1.0 + w.abs()), "{what}[{i}]: {g} vs {w}");
-    }
-}
-
 #[test]
 fn matrix_products_match_f64_on_both_sides_of_the_alignment_patch() {
     let d = device::cpu();
@@ -59,11 +53,11 @@ fn matrix_products_match_f64_on_both_sides_of_the_alignment_patch() {
             let ta = Tensor::<2>::from_data(TensorData::new(a.clone(), [m, k]), &d);
             let tb = Tensor::<2>::from_data(TensorData::new(b.clone(), [k, n]), &d);
             let got = ta.clone().matmul(tb.clone()).into_data().try_to_vec::<f32>().unwrap();
-            assert_close(&got, &want, &format!("[{m}, {k}] x [{k}, {n}]"));
+            assert_close(&format!("[{m}, {k}] x [{k}, {n}]"), &got, &want, 1e-4);
             // The transposed (strided) operand path: (B^T A^T)^T = A B.
             let t = tb.transpose().matmul(ta.transpose()).transpose();
             let got = t.into_data().try_to_vec::<f32>().unwrap();
-            assert_close(&got, &want, &format!("transposed [{m}, {k}] x [{k}, {n}]"));
+            assert_close(&format!("transposed [{m}, {k}] x [{k}, {n}]"), &got, &want, 1e-4);
         }
     }
 }
@@ -84,8 +78,8 @@ fn matrix_product_gradients_match_f64() {
         (0..m * k).map(|i| (0..n).map(|j| f64::from(b[(i % k) * n + j])).sum()).collect();
     let want_b: Vec<f64> =
         (0..k * n).map(|i| (0..m).map(|r| f64::from(a[r * k + i / n])).sum()).collect();
-    assert_close(&ga, &want_a, "dL/dA");
-    assert_close(&gb, &want_b, "dL/dB");
+    assert_close("dL/dA", &ga, &want_a, 1e-4);
+    assert_close("dL/dB", &gb, &want_b, 1e-4);
 }
 
 #[test]
@@ -121,7 +115,7 @@ fn long_products_split_over_k_match_f64_and_not_the_thread_count() {
             y.into_data().try_to_vec::<f32>().unwrap()
         };
         let one = on_threads(1, product);
-        assert_close(&one, &want, &format!("[{k}, {m}]ᵀ x [{k}, {n}]"));
+        assert_close(&format!("[{k}, {m}]ᵀ x [{k}, {n}]"), &one, &want, 1e-4);
         for threads in [2, 3] {
             assert_eq!(on_threads(threads, product), one, "k = {k}, {threads} threads");
         }
@@ -166,7 +160,7 @@ fn element_wise_ops_on_every_thread_equal_the_scalar_ops() {
                 .sum()
         })
         .collect();
-    assert_close(&gb, &want, "bias gradient");
+    assert_close("bias gradient", &gb, &want, 1e-4);
     for threads in [2, 3] {
         assert_eq!(on_threads(threads, step), (y.clone(), gb.clone()), "{threads} threads");
     }

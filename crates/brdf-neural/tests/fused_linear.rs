@@ -12,6 +12,7 @@
 use brdf_neural::device::{self, Backend};
 use brdf_neural::linear_op::linear;
 use brdf_neural::precision::MatmulPrecision;
+use brdf_neural::precision::PrecisionScope;
 use burn::tensor::{Tensor, TensorData};
 
 /// Deterministic values in [-1, 1).

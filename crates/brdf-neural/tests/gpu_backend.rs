@@ -16,7 +16,7 @@
 //! gradients of a loss must match the CPU's to 1e-4 (relative). A Single MLP trained for 30
 //! Adam steps on both backends from the same start must follow the same loss curve to 1e-3, on
 //! the GPU also with its linear layers' batch split into parts as the trainer does there
-//! ([`brdf_neural::split_k`]).
+//! ([`brdf_neural::batch_split`]).
 //!
 //! `NEURAL_BRDF_GPU_LINEAR=ours` runs the whole file with the linear layers on this workspace's
 //! `gpu-kernels` instead of burn's ([`brdf_neural::gpu_linear`]); a test checks that the layers
@@ -25,27 +25,20 @@
 
 mod common;
 
-use brdf_neural::device::Backend;
+use brdf_neural::device::{Backend, BackendDevice};
+use brdf_neural::precision::PrecisionScope;
 use brdf_neural::{BrdfBatch, BrdfModel, ModelConfig, ModelKind, SpatialTable};
 use burn::module::Module;
 use burn::tensor::{Device, Tensor, TensorData};
 use common::{OwnedSamples, parameters, rng, samples, small, train, values};
+use test_support::assert_close_scaled;
 
 /// The backend under test: `BRDF_GPU_BACKEND`, else wgpu when built, else cuda.
 fn gpu() -> Backend {
     match std::env::var("BRDF_GPU_BACKEND") {
-        Ok(name) => Backend::parse(&name).expect("BRDF_GPU_BACKEND"),
+        Ok(name) => brdf_neural::device::parse_backend(&name).expect("BRDF_GPU_BACKEND"),
         Err(_) if cfg!(feature = "wgpu") => Backend::Wgpu,
         Err(_) => Backend::Cuda,
-    }
-}
-
-fn assert_close(got: &[f32], want: &[f32], tol: f32, what: &str) {
-    assert_eq!(got.len(), want.len(), "{what}: length");
-    let scale = want.iter().fold(0.0_f32, |m, w| m.max(w.abs())).max(1e-6);
-    for (i, (g, w)) in got.iter().zip(want).enumerate() {
-        assert!(g.is_finite(), "{what}[{i}] = {g} on the GPU");
-        assert!((g - w).abs() <= tol * scale, "{what}[{i}]: GPU {g} vs CPU {w} (scale {scale})");
     }
 }
 
@@ -85,10 +78,10 @@ fn every_model_kind_gives_the_cpus_values_and_gradients_on_the_gpu() {
         let s = samples(&mut rng(3), 257, c.spatial_dim);
         let (f_cpu, g_cpu) = forward_and_gradients(&model, &c, &s, &cpu);
         let (f_gpu, g_gpu) = forward_and_gradients(&on_gpu, &c, &s, &gpu_device);
-        assert_close(&f_gpu, &f_cpu, 1e-4, &format!("{kind:?} f_r"));
+        assert_close_scaled(&format!("{kind:?} f_r"), &f_gpu, &f_cpu, 1e-4);
         assert_eq!(g_gpu.len(), g_cpu.len(), "{kind:?}: gradient count");
         for (i, (g, w)) in g_gpu.iter().zip(&g_cpu).enumerate() {
-            assert_close(g, w, 1e-4, &format!("{kind:?} gradient {i}"));
+            assert_close_scaled(&format!("{kind:?} gradient {i}"), g, w, 1e-4);
         }
     }
 }
@@ -120,7 +113,7 @@ fn loss_curves(
     let model = BrdfModel::init_seeded(c, &cpu, init, None).unwrap();
     let on_gpu = model.clone().fork(&gpu_device);
     let (_, l_cpu) = train(model, c, data, 30, 3e-3, &cpu);
-    let _split = brdf_neural::split_k::scope(parts);
+    let _split = brdf_neural::batch_split::scope(parts);
     let (trained, l_gpu) = train(on_gpu, c, data, 30, 3e-3, &gpu_device);
     assert!(l_cpu[29] < 0.5 * l_cpu[0], "the CPU fit learns: {l_cpu:?}");
     (l_cpu, l_gpu, trained)
@@ -131,7 +124,7 @@ fn a_single_mlp_trains_along_the_same_loss_curve_on_the_gpu() {
     let c = small(ModelKind::SingleMlp);
     let data = curve_data(&c, 7);
     let (l_cpu, l_gpu, trained) = loss_curves(&c, &data, 5, 1);
-    assert_close(&l_gpu, &l_cpu, 1e-3, "loss curve");
+    assert_close_scaled("loss curve", &l_gpu, &l_cpu, 1e-3);
     // The trained GPU model comes back to the CPU intact.
     let cpu = brdf_neural::device::cpu_training();
     let back = trained.fork(&cpu);
@@ -140,11 +133,11 @@ fn a_single_mlp_trains_along_the_same_loss_curve_on_the_gpu() {
 }
 
 #[test]
-fn the_split_k_trains_along_the_same_loss_curve_on_the_gpu() {
+fn the_batch_split_trains_along_the_same_loss_curve_on_the_gpu() {
     let c = small(ModelKind::SingleMlp);
-    // Two parts of 256 rows each: the split path (split_k::MIN_ROWS).
+    // Two parts of 256 rows each: the split path (batch_split::MIN_ROWS).
     let (l_cpu, l_gpu, _) = loss_curves(&c, &curve_data(&c, 9), 6, 2);
-    assert_close(&l_gpu, &l_cpu, 1e-3, "loss curve with the batch split");
+    assert_close_scaled("loss curve with the batch split", &l_gpu, &l_cpu, 1e-3);
 }
 
 /// bf16 products on the GPU (tensor cores: `--backend cuda` on Ampere or later): a Single MLP
@@ -167,7 +160,7 @@ fn bf16_trains_along_the_cpus_bf16_curve_or_is_refused() {
     let data = curve_data(&c, 11);
     let (l_cpu, l_gpu, _) = loss_curves(&c, &data, 8, 1);
     drop(guard);
-    assert_close(&l_gpu, &l_cpu, 1e-2, "bf16 loss curve");
+    assert_close_scaled("bf16 loss curve", &l_gpu, &l_cpu, 1e-2);
 }
 
 /// The linear layers take the kernels `NEURAL_BRDF_GPU_LINEAR` names: `gpu-kernels` for
@@ -214,6 +207,6 @@ fn spatial_rows_selected_on_the_gpu_are_the_gathered_rows() {
         assert_eq!(values(a.spatial.clone()), values(b.spatial.clone()), "{kind:?}: rows");
         let model = BrdfModel::init(&c, &d).unwrap();
         let (fa, fb) = (values(model.forward(&a).f), values(model.forward(&b).f));
-        assert_close(&fb, &fa, 1e-6, &format!("{kind:?}: output"));
+        assert_close_scaled(&format!("{kind:?}: output"), &fb, &fa, 1e-6);
     }
 }

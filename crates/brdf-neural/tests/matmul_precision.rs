@@ -8,7 +8,9 @@
 #![cfg(feature = "flex")]
 
 use brdf_neural::device::Backend;
+use brdf_neural::device::BackendDevice;
 use brdf_neural::precision::MatmulPrecision;
+use brdf_neural::precision::PrecisionScope;
 use burn::tensor::{Tensor, TensorData};
 
 fn rng(seed: u64) -> impl FnMut() -> f32 {

@@ -9,58 +9,13 @@ use dataset_capture::{export_capture, import_capture};
 use dataset_merl::generate_scene;
 use scene::manifest::Split;
 use scene::{MaterialSpec, SceneConfig, SceneDataset, SceneSettings};
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use test_support::TempDir;
-
-/// OBJ text of a UV sphere (radius 0.5, centre (0, 0, 0.7)) above a square plane z = 0: the
-/// sphere shadows the plane.
-fn sphere_over_plane(dir: &Path) -> PathBuf {
-    let mut obj = String::new();
-    let (rings, segs) = (16, 32);
-    for i in 0..=rings {
-        let th = std::f64::consts::PI * i as f64 / rings as f64;
-        for j in 0..segs {
-            let ph = std::f64::consts::TAU * j as f64 / segs as f64;
-            let p = [th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()];
-            let _ = writeln!(obj, "v {} {} {}", 0.5 * p[0], 0.5 * p[1], 0.7 + 0.5 * p[2]);
-        }
-    }
-    let idx = |i: usize, j: usize| i * segs + (j % segs) + 1;
-    for i in 0..rings {
-        for j in 0..segs {
-            let (a, b, c, d) = (idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1));
-            if i != 0 {
-                let _ = writeln!(obj, "f {a} {b} {d}");
-            }
-            if i != rings - 1 {
-                let _ = writeln!(obj, "f {b} {c} {d}");
-            }
-        }
-    }
-    let base = (rings + 1) * segs;
-    for (x, y) in [(-1.5, -1.5), (1.5, -1.5), (1.5, 1.5), (-1.5, 1.5)] {
-        let _ = writeln!(obj, "v {x} {y} 0");
-    }
-    let _ = writeln!(
-        obj,
-        "f {} {} {}\nf {} {} {}",
-        base + 1,
-        base + 2,
-        base + 3,
-        base + 1,
-        base + 3,
-        base + 4
-    );
-    let path = dir.join("sphere_plane.obj");
-    std::fs::write(&path, obj).unwrap();
-    path
-}
 
 /// A small semi-synthetic scene lit by point lights 2.5 mesh radii from the origin.
 fn point_lit_scene(dir: &Path) -> PathBuf {
     let config = SceneConfig {
-        mesh: sphere_over_plane(dir),
+        mesh: test_support::mesh::write_sphere_over_plane(dir, 16, 32),
         material: MaterialSpec::Lambert { albedo: [0.5, 0.3, 0.8] },
         seed: 11,
         settings: SceneSettings {

@@ -41,12 +41,12 @@
 
 pub mod ball;
 pub mod calibration;
-pub mod capture;
 pub mod decimate;
 mod error;
 pub mod mat5;
 pub mod multi_view;
 pub mod normal_check;
+pub mod pms_dir;
 pub mod report;
 mod scene_writer;
 pub mod single_view;

@@ -21,12 +21,12 @@
 //! Split: alternate views (or a list) x seeded disjoint light sets, see [`crate::split`].
 
 use crate::calibration::Calibration;
-use crate::capture::Capture;
 use crate::decimate::{DecimateOptions, decimate};
 use crate::error::{Error, Result};
 use crate::normal_check::{read_normal_map, summarize, view_errors};
+use crate::pms_dir::Capture;
 use crate::report::ImportReport;
-use crate::scene_writer::{CapturedScene, ViewSpec, write_scene};
+use crate::scene_writer::{CapturedScene, ViewSpec, write_captured_scene};
 use crate::single_view::object_name;
 use crate::split::{split_lights, train_views};
 use glam::DMat3;
@@ -138,7 +138,7 @@ fn open_views(src: &Path, views: usize) -> Result<Vec<Capture>> {
             }
             if (c.width, c.height) != (first.width, first.height) {
                 return Err(Error::input(
-                    c.dir.join(crate::capture::MASK),
+                    c.dir.join(crate::pms_dir::MASK),
                     format!(
                         "{} x {} pixels, but {} has {} x {}",
                         c.width,
@@ -243,7 +243,7 @@ pub fn import_multi_view(src: &Path, out: &Path, o: &MultiViewOptions) -> Result
         saturation_level: o.saturation_level,
         shadow_bias_relative: o.shadow_bias_relative,
     };
-    let written = write_scene(&scene, out, o.progress)?;
+    let written = write_captured_scene(&scene, out, o.progress)?;
     let mut errs = Vec::new();
     for (v, map) in normal_maps.iter().enumerate() {
         if let Some(map) = map {

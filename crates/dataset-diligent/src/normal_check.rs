@@ -3,9 +3,9 @@
 //! outside the object): the angle between the ray-cast interpolated normal and the map's
 //! normal, over the pixels that are in the mask, hit the mesh and have a ground-truth normal.
 
-use crate::capture::diligent_to_opencv;
 use crate::error::{Error, Result};
 use crate::mat5::{MatFile, MatVariable};
+use crate::pms_dir::diligent_to_opencv;
 use crate::report::NormalCheck;
 use glam::{DVec3, Mat3};
 use raycast_precompute::ViewPrecompute;

@@ -16,8 +16,8 @@
 //! [`MaterialSpec::Captured`], cameras, world light directions with their 1-based source image
 //! numbers, file hashes, statistics).
 
-use crate::capture::{Capture, diligent_to_opencv};
 use crate::error::Result;
+use crate::pms_dir::{Capture, diligent_to_opencv};
 use crate::report::ViewReport;
 use glam::{Mat3, Vec3};
 use mesh_encoding::TriMesh;
@@ -145,7 +145,11 @@ fn scene_config(s: &CapturedScene<'_>, views: &[View]) -> Result<SceneConfig> {
 }
 
 /// Writes the scene into `out` (replacing what is there once complete).
-pub(crate) fn write_scene(s: &CapturedScene<'_>, out: &Path, progress: bool) -> Result<Written> {
+pub(crate) fn write_captured_scene(
+    s: &CapturedScene<'_>,
+    out: &Path,
+    progress: bool,
+) -> Result<Written> {
     let (views, infos) = views(s)?;
     let config = scene_config(s, &views)?;
     let contents = SceneContents {

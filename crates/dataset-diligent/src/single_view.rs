@@ -12,11 +12,11 @@
 //! never share a light ([`crate::split::split_lights`]).
 
 use crate::ball::{fit_circle, icosphere, sphere_translation};
-use crate::capture::Capture;
 use crate::error::{Error, Result};
 use crate::normal_check::{read_normal_map, summarize, view_errors};
+use crate::pms_dir::Capture;
 use crate::report::ImportReport;
-use crate::scene_writer::{CapturedScene, ViewSpec, write_scene};
+use crate::scene_writer::{CapturedScene, ViewSpec, write_captured_scene};
 use crate::split::split_lights;
 use glam::{DMat3, Mat3};
 use scene::Split;
@@ -125,7 +125,7 @@ pub fn import_single_view(src: &Path, out: &Path, o: &SingleViewOptions) -> Resu
         ));
     }
     let circle = fit_circle(&capture.mask, capture.width as usize).ok_or_else(|| {
-        Error::input(src.join(crate::capture::MASK), "the mask has no circular outline to fit")
+        Error::input(src.join(crate::pms_dir::MASK), "the mask has no circular outline to fit")
     })?;
     let k = k_rows(o.intrinsics, o.principal_point_offset);
     let k64 = DMat3::from_cols_array_2d(&k.map(|r| r.map(f64::from))).transpose();
@@ -146,7 +146,7 @@ pub fn import_single_view(src: &Path, out: &Path, o: &SingleViewOptions) -> Resu
         source_mesh: PathBuf::from(format!(
             "<unit icosphere level {} fitted to {}>",
             o.sphere_level,
-            src.join(crate::capture::MASK).display()
+            src.join(crate::pms_dir::MASK).display()
         )),
         mesh: icosphere(o.sphere_level),
         captures: &captures,
@@ -156,7 +156,7 @@ pub fn import_single_view(src: &Path, out: &Path, o: &SingleViewOptions) -> Resu
         saturation_level: o.saturation_level,
         shadow_bias_relative: o.shadow_bias_relative,
     };
-    let written = write_scene(&scene, out, o.progress)?;
+    let written = write_captured_scene(&scene, out, o.progress)?;
 
     let normal_check = gt.and_then(|var| {
         summarize(view_errors(&written.geometry.views[0], &captures[0].mask, Mat3::IDENTITY, &var))

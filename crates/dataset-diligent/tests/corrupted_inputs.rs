@@ -5,8 +5,8 @@
 
 mod common;
 
-use dataset_diligent::capture::{Capture, read_png16};
 use dataset_diligent::mat5::{MatFile, write_mat5};
+use dataset_diligent::pms_dir::{Capture, read_png16};
 use std::path::Path;
 use test_support::corrupt::{CappedAlloc, fuzz_loader};
 

@@ -12,58 +12,7 @@ use dataset_merl::generate_scene;
 use scene::SceneDataset;
 use scene::Split;
 use scene::{MaterialSpec, SceneConfig, SceneSettings};
-use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
-
-/// OBJ text of a UV sphere (radius 0.5, centre (0, 0, 0.7)) above a square plane z = 0.
-fn sphere_over_plane(dir: &Path) -> PathBuf {
-    let mut obj = String::new();
-    let (rings, segs) = (24, 48);
-    let c = [0.0, 0.0, 0.7];
-    for i in 0..=rings {
-        let th = std::f64::consts::PI * i as f64 / rings as f64;
-        for j in 0..segs {
-            let ph = std::f64::consts::TAU * j as f64 / segs as f64;
-            let p = [th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()];
-            let _ = writeln!(
-                obj,
-                "v {} {} {}",
-                c[0] + 0.5 * p[0],
-                c[1] + 0.5 * p[1],
-                c[2] + 0.5 * p[2]
-            );
-        }
-    }
-    let idx = |i: usize, j: usize| i * segs + (j % segs) + 1;
-    for i in 0..rings {
-        for j in 0..segs {
-            let (a, b, cc, d) = (idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1));
-            if i != 0 {
-                let _ = writeln!(obj, "f {a} {b} {d}");
-            }
-            if i != rings - 1 {
-                let _ = writeln!(obj, "f {b} {cc} {d}");
-            }
-        }
-    }
-    let base = (rings + 1) * segs;
-    for (x, y) in [(-1.5, -1.5), (1.5, -1.5), (1.5, 1.5), (-1.5, 1.5)] {
-        let _ = writeln!(obj, "v {x} {y} 0");
-    }
-    let _ = writeln!(
-        obj,
-        "f {} {} {}\nf {} {} {}",
-        base + 1,
-        base + 2,
-        base + 3,
-        base + 1,
-        base + 3,
-        base + 4
-    );
-    let path = dir.join("sphere_plane.obj");
-    std::fs::write(&path, obj).unwrap();
-    path
-}
+use std::path::PathBuf;
 
 fn small_settings() -> SceneSettings {
     SceneSettings {
@@ -90,7 +39,7 @@ fn lambert_config(mesh: PathBuf) -> SceneConfig {
 #[test]
 fn lambertian_renders_rho_over_pi_e_cos_and_shadows_are_zero() {
     let dir = TempDir::new("lambert");
-    let cfg = lambert_config(sphere_over_plane(&dir.0));
+    let cfg = lambert_config(test_support::mesh::write_sphere_over_plane(&dir.0, 24, 48));
     let out = dir.0.join("scene");
     let report = generate_scene(&cfg, &out, false).unwrap();
     assert!(!report.skipped && report.label == "analytic (Lambert)");
@@ -155,7 +104,7 @@ fn lambertian_renders_rho_over_pi_e_cos_and_shadows_are_zero() {
 #[test]
 fn generation_is_deterministic_resumable_and_seeded() {
     let dir = TempDir::new("determinism");
-    let cfg = lambert_config(sphere_over_plane(&dir.0));
+    let cfg = lambert_config(test_support::mesh::write_sphere_over_plane(&dir.0, 24, 48));
     let (a, b) = (dir.0.join("a"), dir.0.join("b"));
     generate_scene(&cfg, &a, false).unwrap();
     generate_scene(&cfg, &b, false).unwrap();
@@ -182,7 +131,7 @@ fn generation_is_deterministic_resumable_and_seeded() {
 #[test]
 fn loader_rejects_tampered_scenes() {
     let dir = TempDir::new("tamper");
-    let cfg = lambert_config(sphere_over_plane(&dir.0));
+    let cfg = lambert_config(test_support::mesh::write_sphere_over_plane(&dir.0, 24, 48));
     let out = dir.0.join("scene");
     generate_scene(&cfg, &out, false).unwrap();
     let manifest_path = out.join("manifest.json");
@@ -221,13 +170,13 @@ fn bad_inputs_are_clear_errors_and_leave_nothing_behind() {
     assert!(msg.contains("bad.obj"), "{msg}");
     let unknown = SceneConfig {
         material: MaterialSpec::Merl { name: "unobtainium".into() },
-        ..lambert_config(sphere_over_plane(&dir.0))
+        ..lambert_config(test_support::mesh::write_sphere_over_plane(&dir.0, 24, 48))
     };
     let msg = generate_scene(&unknown, &out, false).unwrap_err().to_string();
     assert!(msg.contains("unobtainium"), "{msg}");
     let captured = SceneConfig {
         material: MaterialSpec::Captured { benchmark: "DiLiGenT".into(), object: "ball".into() },
-        ..lambert_config(sphere_over_plane(&dir.0))
+        ..lambert_config(test_support::mesh::write_sphere_over_plane(&dir.0, 24, 48))
     };
     let msg = generate_scene(&captured, &out, false).unwrap_err().to_string();
     assert!(msg.contains("imported") && msg.contains("ball"), "{msg}");
@@ -249,7 +198,7 @@ fn merl_scene_stores_the_table_lookup_as_ground_truth() {
     let dir = TempDir::new("merl");
     let cfg = SceneConfig {
         material: MaterialSpec::Merl { name: "maroon-plastic".into() },
-        ..lambert_config(sphere_over_plane(&dir.0))
+        ..lambert_config(test_support::mesh::write_sphere_over_plane(&dir.0, 24, 48))
     };
     let out = dir.0.join("scene");
     let r = generate_scene(&cfg, &out, false).unwrap();

@@ -133,7 +133,7 @@ pub enum RunCommand {
 
 /// `--backend`: a backend name (see `brdf_neural::device`).
 pub fn parse_backend(name: &str) -> std::result::Result<Backend, String> {
-    Backend::parse(name).map_err(|e| e.to_string())
+    brdf_neural::device::parse_backend(name).map_err(|e| e.to_string())
 }
 
 /// Runs one subcommand, printing its outcome.

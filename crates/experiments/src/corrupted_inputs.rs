@@ -26,9 +26,7 @@ fn corrupted_run_configs_give_errors_not_panics() {
 
 #[test]
 fn corrupted_probe_files_give_errors_not_panics() {
-    let white = metrics::AnalyticBatch(brdf_analytic::Lambert::new(brdf_analytic::LambertParams {
-        albedo: [0.5f32; 3],
-    }));
+    let white = brdf_analytic::Lambert::new(brdf_analytic::LambertParams { albedo: [0.5f32; 3] });
     let p = crate::eval::probe::probe(&white, 0, String::new(), None);
     let tmp = test_support::TempDir::new("fuzz-probe");
     let path = tmp.0.join("probe.bin");

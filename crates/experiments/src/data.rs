@@ -9,11 +9,11 @@
 use crate::loss::srgb_oetf;
 use crate::{Error, Result};
 use angles::Frame;
-use mesh_encoding::{EigenSettings, LboEncoding, cached_eigenpairs};
+use mesh_encoding::{EigenSettings, LboEncoding, LboEncodingConfig, cached_eigenpairs};
 use rand::SeedableRng;
 use rand::rngs::StdRng;
 use rand::seq::SliceRandom;
-use run_format::config::{FeatureConfig, SpatialKind};
+use run_format::config::{FeatureConfig, RunConfig, SpatialKind};
 use scene::Split;
 use scene::shading::light_weight;
 use scene::{SampleSet, SceneDataset};
@@ -21,9 +21,10 @@ use std::collections::{HashMap, HashSet};
 use std::path::Path;
 use std::sync::Arc;
 
-/// Samples ready for batching, struct of arrays.
+/// The lit records of one split (training, validation or test), struct of arrays: what a
+/// fit batches from and what evaluation scores.
 #[derive(Clone, Debug, Default)]
-pub struct TrainingData {
+pub struct RecordSet {
     /// Spatial features of the distinct surface points, row-major `[points, spatial_dim]`,
     /// shared between the training and validation records (a pixel's records under all its
     /// lights are one point: 42x less memory than a row per record, which at 512 px would not
@@ -46,7 +47,7 @@ pub struct TrainingData {
     /// Index of each record in the source [`SampleSet`].
     pub source: Vec<usize>,
     /// The sensor's clip level of the scene (semi-synthetic scenes; see
-    /// [`crate::eval::images::clip_level`]): renders are compared after clipping there.
+    /// [`crate::data::clip_level`]): renders are compared after clipping there.
     pub clip: Option<f32>,
 }
 
@@ -68,7 +69,7 @@ pub struct CpuBatch {
     pub target_gamma: Vec<f32>,
 }
 
-impl TrainingData {
+impl RecordSet {
     /// Number of records.
     pub fn len(&self) -> usize {
         self.l.len()
@@ -92,7 +93,7 @@ impl TrainingData {
         spatial: &SpatialFeatures,
         indices: impl IntoIterator<Item = usize>,
     ) -> Self {
-        let mut d = TrainingData {
+        let mut d = RecordSet {
             spatial: spatial.table.clone(),
             spatial_dim: spatial.dim,
             ..Default::default()
@@ -118,17 +119,26 @@ impl TrainingData {
 
     /// The spatial features of record `i`.
     pub fn spatial_row(&self, i: usize) -> &[f32] {
-        let (p, k) = (self.point[i] as usize, self.spatial_dim);
-        &self.spatial[p * k..(p + 1) * k]
+        self.points().row(i)
     }
 
     /// The spatial rows of `records`, row-major (the input of a batch).
     pub fn spatial_rows(&self, records: std::ops::Range<usize>) -> Vec<f32> {
-        let mut out = Vec::with_capacity(records.len() * self.spatial_dim);
-        for i in records {
-            out.extend_from_slice(self.spatial_row(i));
+        self.points().rows(records)
+    }
+
+    /// The records' points and the points' spatial rows, as a model evaluates them.
+    pub fn points(&self) -> brdf_neural::fitted::PointRows<'_> {
+        brdf_neural::fitted::PointRows {
+            spatial: &self.spatial,
+            dim: self.spatial_dim,
+            point: &self.point,
         }
-        out
+    }
+
+    /// The records (points and directions), as a model evaluates them.
+    pub fn records(&self) -> brdf_neural::fitted::Records<'_> {
+        brdf_neural::fitted::Records { points: self.points(), l: &self.l, v: &self.v }
     }
 
     /// The least-squares constant BRDF of the records, per channel: the f minimising
@@ -174,14 +184,14 @@ impl TrainingData {
         CpuBatch { spatial, ..self.gather_fields(indices) }
     }
 
-    /// The points (rows of [`TrainingData::spatial`]) of the records at `indices`: with
-    /// [`TrainingData::gather_fields`], a batch whose spatial rows are selected elsewhere (on
+    /// The points (rows of [`RecordSet::spatial`]) of the records at `indices`: with
+    /// [`RecordSet::gather_fields`], a batch whose spatial rows are selected elsewhere (on
     /// the device, from a `brdf_neural::SpatialTable`).
     pub fn points_of(&self, indices: &[usize]) -> Vec<u32> {
         indices.iter().map(|&i| self.point[i]).collect()
     }
 
-    /// [`TrainingData::gather`] without the spatial rows (`spatial` left empty).
+    /// [`RecordSet::gather`] without the spatial rows (`spatial` left empty).
     pub fn gather_fields(&self, indices: &[usize]) -> CpuBatch {
         use rayon::prelude::*;
         const ROWS: usize = GATHER_ROWS;
@@ -337,6 +347,29 @@ pub fn spatial_features(
     Ok(SpatialFeatures { table: Arc::new(table), dim, point })
 }
 
+/// The clip level renders get: the saturation of semi-synthetic scenes, none for captures
+/// (whose observations are raw values divided by a per-light intensity).
+pub fn clip_level(dataset: &SceneDataset) -> Option<f32> {
+    use scene::MaterialSpec;
+    let c = &dataset.manifest.config;
+    (!matches!(c.material, MaterialSpec::Captured { .. })).then_some(c.settings.saturation)
+}
+
+/// The per-vertex spatial features `[vertices, dim]` of a scene's mesh under `config`.
+pub fn vertex_features(
+    scene: &SceneDataset,
+    config: &RunConfig,
+    cache: &Path,
+) -> Result<(Vec<f32>, usize)> {
+    match config.features.spatial {
+        SpatialKind::Lbo => lbo_table(scene, &config.features, cache),
+        SpatialKind::Position => {
+            Ok((scene.mesh.positions.iter().flat_map(|p| p.to_array()).collect(), 3))
+        }
+        SpatialKind::Uniform => Ok((vec![1.0; scene.mesh.positions.len()], 1)),
+    }
+}
+
 /// The per-vertex LBO feature table `[vertices, dim]` of the scene's mesh, from
 /// `<cache_dir>/lbo-table-<mesh and solver key>-<selection>.bin` (the workspace's checked cache
 /// container) or computed (then cached).
@@ -349,7 +382,7 @@ pub fn lbo_table(
     const TABLE_VERSION: u32 = 1;
     const MAGIC: &[u8; 8] = b"NBLBOTAB";
     let sel = &features.lbo;
-    let config = sel.encoding()?;
+    let config = encoding_config(features)?;
     let vertices: Vec<[f64; 3]> =
         scene.mesh.positions.iter().map(|p| [p.x as f64, p.y as f64, p.z as f64]).collect();
     let key = mesh_encoding::lbo::cache_key(
@@ -375,6 +408,12 @@ pub fn lbo_table(
     Ok((table, encoding.dim()))
 }
 
+/// mesh-encoding's configuration of the run's LBO selection (run-format states the selection
+/// as data: its indices).
+fn encoding_config(features: &FeatureConfig) -> Result<LboEncodingConfig> {
+    Ok(LboEncodingConfig { selection: features.lbo.indices()?, ..LboEncodingConfig::default() })
+}
+
 fn eigen_settings(features: &FeatureConfig) -> EigenSettings {
     EigenSettings { max_basis_factor: features.lbo.max_basis_factor, ..EigenSettings::default() }
 }
@@ -386,7 +425,7 @@ pub fn lbo_encoding(
     features: &FeatureConfig,
     cache_dir: &Path,
 ) -> Result<LboEncoding> {
-    let config = features.lbo.encoding()?;
+    let config = encoding_config(features)?;
     let vertices: Vec<[f64; 3]> =
         scene.mesh.positions.iter().map(|p| [p.x as f64, p.y as f64, p.z as f64]).collect();
     std::fs::create_dir_all(cache_dir).map_err(|e| Error::io(cache_dir, e))?;
@@ -404,11 +443,29 @@ pub fn lbo_encoding(
 
 #[cfg(test)]
 mod tests {
+    /// run-format states the LBO selection and the solver's default as data; they are
+    /// mesh-encoding's.
+    #[test]
+    fn the_run_formats_lbo_defaults_are_the_encodings() {
+        use run_format::config::{DEFAULT_MAX_BASIS_FACTOR, LboSelection};
+        let sel = LboSelection::default();
+        assert_eq!(sel.indices().unwrap(), mesh_encoding::LboEncodingConfig::default().selection);
+        assert_eq!(DEFAULT_MAX_BASIS_FACTOR, super::EigenSettings::default().max_basis_factor);
+        for (first, blocks, block_len, k_max) in
+            [(0, 1, 4, 4), (10, 3, 5, 100), (64, 6, 16, 512), (3, 0, 16, 3)]
+        {
+            let sel = LboSelection { first, blocks, block_len, k_max, ..LboSelection::default() };
+            let want =
+                mesh_encoding::lbo::encoding::block_selection(first, blocks, block_len, k_max);
+            assert_eq!(sel.indices().unwrap(), want, "{first} {blocks} {block_len} {k_max}");
+        }
+    }
+
     use super::*;
 
-    fn records(n: usize, points: usize, k: usize) -> TrainingData {
+    fn records(n: usize, points: usize, k: usize) -> RecordSet {
         let f = |i: usize, c: usize| ((i * 7 + c) as f32 * 0.61).sin();
-        TrainingData {
+        RecordSet {
             spatial: Arc::new((0..points * k).map(|i| f(i, 0)).collect()),
             spatial_dim: k,
             point: (0..n).map(|i| ((i * 31) % points) as u32).collect(),

@@ -1,15 +1,18 @@
 //! The stages of one run (spec sections 6 and 7): training, evaluation and export, importing
-//! one way: `train` uses `eval` and `export`, `export` uses `eval`, `eval` uses neither.
+//! one way: `export` may use `eval`; `train` and `eval` use neither other stage. What they
+//! pass on sits below them: [`data`] (records, features), [`fitted`] (a fitted run opened
+//! for analysis) and [`portable`] (the weights every fit writes for other tools).
 //! Everything the stages share about a run (its configuration, its directory, its records,
 //! the results version) lives in the crate `run_format` below; sweeps of many runs live in
 //! the crate `sweep` above.
 //!
 //! * [`data`]: the lit training records (spatial features, local directions, E cos) and batches.
 //! * [`loss`]: the sRGB-gamma MSE and the enhanced split's regularisers.
-//! * [`train`], [`trainer`]: [`fit`] and its loop: validation, checkpoints, snapshots, resume
+//! * [`train`], [`train_loop`]: [`fit`] and its loop: validation, checkpoints, snapshots, resume
 //!   and non-finite detection ([`checkpoint`], [`diagnose`]); [`interrupt`]: a SIGTERM (a
 //!   cluster's preemption or time limit) ends a fit at a step boundary with a checkpoint.
 //! * [`eval`]: test renders, maps and every metric of a finished run.
+//! * [`fitted`]: a finished (or just trained) run: configuration, model, scene.
 //! * [`export`]: a fitted model for renderers (glTF, Mitsuba 3, pbrt-v4) and as a MERL table.
 //!
 //! The binary `experiments` wraps these as `fit`, `eval` and `export` (`experiments --help`;
@@ -39,14 +42,16 @@ pub mod diagnose;
 mod error;
 pub mod eval;
 pub mod export;
+pub mod fitted;
 pub mod interrupt;
 pub mod loss;
 mod loss_window;
+pub mod portable;
 pub mod train;
-pub mod trainer;
+pub mod train_loop;
 
 /// The burn backend a fit or an evaluation runs on (`--backend`).
-pub use brdf_neural::device::Backend;
+pub use brdf_neural::device::{Backend, BackendDevice};
 pub use brdf_neural::precision::MatmulPrecision;
 pub use error::{Error, Result};
 pub use run_format::RunConfig;

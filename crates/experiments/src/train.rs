@@ -7,7 +7,7 @@
 //! swaps l and v per sample. A fraction of each training view's lights is held out: their
 //! validation loss drives the plateau schedule, which decays the rate and stops a converged
 //! run ([`run_format::train_config`], [`run_format::plateau`]). The loop itself is in
-//! [`crate::trainer`].
+//! [`crate::train_loop`].
 //!
 //! Checkpoints every `checkpoint_every` steps hold the weights, Adam's state, the curve and
 //! the plateau rule's state, so a resumed run computes the same steps as an uninterrupted one.
@@ -17,14 +17,15 @@
 //! checkpoint that resumes it.
 
 use crate::checkpoint::{self, CheckpointState};
-use crate::data::{TrainingData, spatial_features, split_validation, validation_pairs};
-use crate::eval::FittedRun;
-use crate::trainer::{
-    GPU_LOSS_READS, Loop, LoopEnd, device_records, device_table, gamma_mse, save_weights,
-};
+use crate::data::{RecordSet, spatial_features, split_validation, validation_pairs};
+use crate::fitted::FittedRun;
+use crate::train_loop::{GPU_LOSS_READS, Loop, LoopEnd, gamma_mse, save_weights};
 use crate::{Error, Result};
+use brdf_neural::device::BackendDevice;
+use brdf_neural::fitted::{device_records, device_table};
 use brdf_neural::precision::MatmulPrecision;
-use brdf_neural::{BrdfModel, split_k};
+use brdf_neural::precision::PrecisionScope;
+use brdf_neural::{BrdfModel, batch_split};
 use burn::module::Module;
 use burn::optim::AdamConfig;
 use burn::tensor::Device;
@@ -36,7 +37,7 @@ use scene::SceneDataset;
 use scene::Split;
 use std::path::{Path, PathBuf};
 
-pub use crate::trainer::StepHook;
+pub use crate::train_loop::StepHook;
 
 /// Options of [`fit`] that are not part of the run's configuration.
 #[derive(Default)]
@@ -55,13 +56,13 @@ pub struct FitOptions {
     /// The burn backend that trains (`--backend`; default: the CPU backend).
     pub backend: brdf_neural::device::Backend,
     /// Whether each batch selects its inputs from tables kept on the device: its spatial rows
-    /// ([`crate::trainer::device_table`]) and its records' directions, weights and targets
-    /// ([`crate::trainer::device_records`]), so that a step uploads only its record indices;
+    /// ([`brdf_neural::fitted::device_table`]) and its records' directions, weights and targets
+    /// ([`brdf_neural::fitted::device_records`]), so that a step uploads only its record indices;
     /// `None`: on GPU backends. The same values either way (tests compare the two on the CPU).
     pub inputs_on_device: Option<bool>,
     /// Steps between host reads of the training loss; between reads each step's loss stays
     /// on the device and the host queues the next step at once. `None`: 1 on the CPU,
-    /// [`crate::trainer::GPU_LOSS_READS`] on GPU backends. The losses and weights do not
+    /// [`crate::train_loop::GPU_LOSS_READS`] on GPU backends. The losses and weights do not
     /// depend on it (a non-finite loss is still named at its step).
     pub loss_reads: Option<u64>,
 }
@@ -107,9 +108,9 @@ pub struct RunData {
     /// The scene.
     pub scene: SceneDataset,
     /// Training records (the training split less the validation lights).
-    pub train: TrainingData,
+    pub train: RecordSet,
     /// Validation records (empty without a validation split).
-    pub val: TrainingData,
+    pub val: RecordSet,
     /// The validation loss of the ground-truth BRDF: the noise floor no model gets below
     /// (`None` without validation records or without a ground truth, as for captures).
     pub val_floor: Option<f64>,
@@ -127,9 +128,9 @@ pub fn training_data(config: &RunConfig, cache_dir: &Path) -> Result<RunData> {
     let t = &config.train;
     let pairs = validation_pairs(&scene, t.validation_fraction);
     let (train, val) = split_validation(&samples, &pairs, t.validation_records, config.seed);
-    let clip = crate::eval::images::clip_level(&scene);
-    let mut train = TrainingData::from_indices(&samples, &spatial, train);
-    let mut val = TrainingData::from_indices(&samples, &spatial, val);
+    let clip = crate::data::clip_level(&scene);
+    let mut train = RecordSet::from_indices(&samples, &spatial, train);
+    let mut val = RecordSet::from_indices(&samples, &spatial, val);
     (train.clip, val.clip) = (clip, clip);
     if train.is_empty() {
         return Err(Error::NoSamples { path: scene_dir.clone() });
@@ -252,13 +253,22 @@ pub fn fit_and_keep(
     }
     let bar = progress_bar(options.progress, t.iterations, state.step);
     let on_device = options.inputs_on_device.unwrap_or(options.backend.is_gpu());
-    let spatial = device_table(&config.model, &data, on_device, &device)?;
+    let spatial = device_table(&config.model, data.points(), on_device, &device)?;
     let has_val = !val.is_empty();
     let val_spatial =
-        device_table(&config.model, &val, on_device && has_val, &device.clone().inner())?;
+        device_table(&config.model, val.points(), on_device && has_val, &device.clone().inner())?;
     let gpu_reads = if options.backend.is_gpu() { GPU_LOSS_READS } else { 1 };
     let loss_reads = options.loss_reads.or(loss_reads_from_env()?).unwrap_or(gpu_reads).max(1);
-    let records = device_records(&config.model, &data, spatial.as_ref(), on_device, &device)?;
+    let (weight, target) = (&data.weight, &data.observed_gamma);
+    let records = device_records(
+        &config.model,
+        data.records(),
+        weight,
+        target,
+        spatial.as_ref(),
+        on_device,
+        &device,
+    )?;
     let lp = Loop {
         config,
         run: &dir,
@@ -294,8 +304,8 @@ pub fn fit_and_keep(
     }
     // On a GPU, the weight gradients' sum over the batch is split into parts (split-K): the
     // GPU's matrix-product kernels do not split it themselves. The CPU keeps the plain product.
-    let parts = if options.backend.is_gpu() { split_k::gpu_parts(t.batch_size) } else { 1 };
-    let split = split_k::scope(parts);
+    let parts = if options.backend.is_gpu() { batch_split::gpu_parts(t.batch_size) } else { 1 };
+    let split = batch_split::scope(parts);
     // burn and CubeCL panic when a GPU runs out of memory or is lost: end with an error that
     // says so and names the checkpoint that resumes, as for any other failure.
     let (hook, stop_after) = (options.hook, options.stop_after);
@@ -330,7 +340,7 @@ pub fn fit_and_keep(
     save_weights(&model, &dir.weights())?;
     // The same weights for other tools (safetensors + JSON), before metrics.json marks the run
     // finished, so a kill in between redoes both.
-    crate::export::portable::write(&dir, &dir.weights(), config, &scene, &cache)?;
+    crate::portable::write(&dir, &dir.weights(), config, &scene, &cache)?;
     let mut metrics = run_metrics(config, &state, &data, val.len());
     metrics.backend = Some(options.backend);
     metrics.startup_seconds = lp.startup_seconds.get();
@@ -378,7 +388,7 @@ fn progress_bar(visible: bool, budget: u64, position: u64) -> ProgressBar {
 fn run_metrics(
     config: &RunConfig,
     state: &CheckpointState,
-    data: &TrainingData,
+    data: &RecordSet,
     val_records: usize,
 ) -> RunMetrics {
     let tail = (state.curve.len() / 10).max(1).min(state.curve.len());

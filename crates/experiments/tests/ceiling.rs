@@ -5,7 +5,7 @@
 //! model off by a few percent scores below the ceiling, and its whole-frame PSNR exceeds its
 //! masked one by exactly 10 log10(frame pixels / object pixels).
 
-use experiments::data::{SpatialFeatures, TrainingData};
+use experiments::data::{RecordSet, SpatialFeatures};
 use experiments::eval::Prediction;
 use experiments::eval::images::{RenderOptions, render_and_score};
 use scene::SceneDataset;
@@ -39,7 +39,7 @@ fn the_ground_truth_scores_the_noise_ceiling_exactly() {
     assert!(scene.has_clean_renders());
     let samples = scene.samples(Split::Test).unwrap();
     let none = SpatialFeatures { point: vec![0; samples.len()], ..Default::default() };
-    let data = TrainingData::new(&samples, &none);
+    let data = RecordSet::new(&samples, &none);
     assert!(!data.is_empty());
     let gt: Vec<[f32; 3]> = data.source.iter().map(|&i| samples.gt_brdf[i]).collect();
     let opts = RenderOptions {
@@ -78,7 +78,7 @@ fn the_papers_protocol_scores_the_whole_frame_against_the_noise_free_renders() {
     let scene = smoke_scene(&dir.0);
     let samples = scene.samples(Split::Test).unwrap();
     let none = SpatialFeatures { point: vec![0; samples.len()], ..Default::default() };
-    let data = TrainingData::new(&samples, &none);
+    let data = RecordSet::new(&samples, &none);
     let gt: Vec<[f32; 3]> = data.source.iter().map(|&i| samples.gt_brdf[i]).collect();
     let opts = RenderOptions {
         run: &dir.0,

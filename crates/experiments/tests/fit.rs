@@ -9,46 +9,10 @@ use burn::tensor::Tensor;
 use experiments::{Error, FitOptions, FitOutcome, RunConfig, fit};
 use run_format::RunDir;
 use scene::{MaterialSpec, SceneConfig, SceneSettings};
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use test_support::TempDir;
-
-/// OBJ of a UV sphere (radius 0.5, centre (0, 0, 0.7)) above the square z = 0.
-fn sphere_over_plane(dir: &Path) -> PathBuf {
-    let mut obj = String::new();
-    let (rings, segs) = (16, 32);
-    for i in 0..=rings {
-        let th = std::f64::consts::PI * i as f64 / rings as f64;
-        for j in 0..segs {
-            let ph = std::f64::consts::TAU * j as f64 / segs as f64;
-            let (x, y, z) = (th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
-            let _ = writeln!(obj, "v {} {} {}", 0.5 * x, 0.5 * y, 0.7 + 0.5 * z);
-        }
-    }
-    let idx = |i: usize, j: usize| i * segs + (j % segs) + 1;
-    for i in 0..rings {
-        for j in 0..segs {
-            let (a, b, c, d) = (idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1));
-            if i != 0 {
-                let _ = writeln!(obj, "f {a} {b} {d}");
-            }
-            if i != rings - 1 {
-                let _ = writeln!(obj, "f {b} {c} {d}");
-            }
-        }
-    }
-    let base = (rings + 1) * segs;
-    for (x, y) in [(-1.5, -1.5), (1.5, -1.5), (1.5, 1.5), (-1.5, 1.5)] {
-        let _ = writeln!(obj, "v {x} {y} 0");
-    }
-    let (p, q, r, s) = (base + 1, base + 2, base + 3, base + 4);
-    let _ = writeln!(obj, "f {p} {q} {r}\nf {p} {r} {s}");
-    let path = dir.join("sphere_plane.obj");
-    std::fs::write(&path, obj).unwrap();
-    path
-}
 
 /// The scene, generated once per test process.
 fn scene() -> &'static Path {
@@ -57,7 +21,7 @@ fn scene() -> &'static Path {
         .get_or_init(|| {
             let dir = TempDir::new("scene");
             let config = SceneConfig {
-                mesh: sphere_over_plane(&dir.0),
+                mesh: test_support::mesh::write_sphere_over_plane(&dir.0, 16, 32),
                 material: MaterialSpec::Lambert { albedo: [0.6, 0.3, 0.15] },
                 seed: 3,
                 settings: SceneSettings {
@@ -487,8 +451,8 @@ fn lbo_features_are_interpolated_and_cached() {
 
 #[test]
 fn fits_export_to_renderers() {
-    use experiments::eval::FittedRun;
     use experiments::export::{ExportedMaterial, Format, export, gltf};
+    use experiments::fitted::FittedRun;
     use run_format::config::SpatialKind;
     let dir = TempDir::new("export");
     for kind in ["ts", "disney"] {

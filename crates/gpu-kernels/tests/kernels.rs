@@ -15,6 +15,7 @@ use gpu_kernels::checks;
 use gpu_kernels::gemm::Tiling;
 use gpu_kernels::linear::Precision::{Bf16, F32};
 use gpu_kernels::linear::{self, Matrix, TilingScope};
+use test_support::assert_close;
 
 /// The runtime under test: `GPU_KERNELS_RUNTIME=cuda` (with the `cuda` feature), else wgpu.
 fn client() -> Client {
@@ -73,19 +74,6 @@ fn transpose(a: &[f32], rows: usize, cols: usize) -> Vec<f32> {
         }
     }
     t
-}
-
-/// Asserts |got - want| <= tol (1 + |want|) elementwise; NaN must meet NaN.
-fn assert_close(what: &str, got: &[f32], want: &[f64], tol: f64) {
-    assert_eq!(got.len(), want.len(), "{what}: length");
-    for (i, (&g, &w)) in got.iter().zip(want).enumerate() {
-        if w.is_nan() {
-            assert!(g.is_nan(), "{what}[{i}]: {g}, want NaN");
-            continue;
-        }
-        let err = (g as f64 - w).abs();
-        assert!(err <= tol * (1.0 + w.abs()), "{what}[{i}]: {g}, want {w} (error {err:e})");
-    }
 }
 
 /// The shapes: (rows, d_in, d_out), tile-filling and ragged, short and long batches (the long

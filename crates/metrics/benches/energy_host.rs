@@ -1,5 +1,5 @@
 //! The host's share of the paper's energy protocol (20,000 cosine-weighted samples a pair)
-//! for a model that runs elsewhere: a stand-in [`BatchBrdf`] that is not `parallel` (as a
+//! for a model that runs elsewhere: a stand-in [`SurfaceBrdf`] that is not `parallel` (as a
 //! model on a GPU) and costs next to nothing, so the time is the sampling, the batch assembly
 //! and the sums. `ENERGY_BENCH_BATCH` (default 262144, `experiments`' GPU pass) is the model's
 //! preferred batch: 13 pairs a call at 2^18, one at 2^15. The summary line gives ns per
@@ -7,16 +7,16 @@
 //!
 //! `cargo bench -p metrics --bench energy_host`
 
+use brdf_analytic::SurfaceBrdf;
 use criterion::{Criterion, criterion_group, criterion_main};
-use metrics::BatchBrdf;
 use metrics::energy::{EnergyConfig, EnergyPair, Estimator, energy_conservation};
 use std::time::Instant;
 
 /// f = 0.3 cos(theta_v) / pi per channel, evaluated on one thread.
 struct Remote(usize);
 
-impl BatchBrdf for Remote {
-    fn eval_batch(&self, _: &[u32], _: &[[f32; 3]], v: &[[f32; 3]], out: &mut [[f32; 3]]) {
+impl SurfaceBrdf for Remote {
+    fn eval_points(&self, _: &[u32], _: &[[f32; 3]], v: &[[f32; 3]], out: &mut [[f32; 3]]) {
         for (o, v) in out.iter_mut().zip(v) {
             *o = [v[2] * 0.3 / std::f32::consts::PI; 3];
         }

@@ -2,19 +2,17 @@
 //! is not energy-conserving at grazing light): `cargo run -p metrics --example energy_timing --
 //! [pairs] [samples]` (defaults: 2,000 pairs, the paper's 20,000 samples per pair).
 
-use metrics::AnalyticBatch;
 use metrics::energy::{EnergyConfig, EnergyPair, Estimator, energy_conservation};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<usize> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
     let n_pairs = args.first().copied().unwrap_or(2_000);
     let samples = args.get(1).copied().unwrap_or(20_000);
-    let brdf =
-        AnalyticBatch(brdf_analytic::TorranceSparrow::new(brdf_analytic::TorranceSparrowParams {
-            roughness: 0.6,
-            diffuse: [1.0, 0.9, 0.5],
-            f0: [0.9; 3],
-        }));
+    let brdf = brdf_analytic::TorranceSparrow::new(brdf_analytic::TorranceSparrowParams {
+        roughness: 0.6,
+        diffuse: [1.0, 0.9, 0.5],
+        f0: [0.9; 3],
+    });
     // Light directions uniform in solid angle over the upper hemisphere (golden-ratio lattice).
     let pairs: Vec<EnergyPair> = (0..n_pairs)
         .map(|i| {

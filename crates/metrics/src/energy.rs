@@ -33,8 +33,8 @@
 
 pub mod mixture;
 
-use crate::batch::BatchBrdf;
 use crate::error::{Error, Result};
+use brdf_analytic::SurfaceBrdf;
 use mixture::{COMPONENTS, Mixture};
 use rand::{Rng, SeedableRng, rngs::StdRng};
 use rayon::prelude::*;
@@ -43,7 +43,7 @@ use std::time::Instant;
 /// One (x, l) pair: the surface point's index and the light direction in its local frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EnergyPair {
-    /// Point index passed to [`BatchBrdf::eval_batch`].
+    /// Point index passed to [`SurfaceBrdf::eval_points`].
     pub point: u32,
     /// Light direction, local frame (unit, normal on +z).
     pub l: [f32; 3],
@@ -181,7 +181,7 @@ fn pair_rng(seed: u64, index: usize) -> StdRng {
 
 /// Evaluates f for `points`, `l`, `v` in calls of at most `batch` entries.
 fn eval_chunked(
-    brdf: &impl BatchBrdf,
+    brdf: &impl SurfaceBrdf,
     pts: &[u32],
     l: &[[f32; 3]],
     v: &[[f32; 3]],
@@ -190,13 +190,13 @@ fn eval_chunked(
     let mut out = vec![[0.0f32; 3]; l.len()];
     for s in (0..l.len()).step_by(batch) {
         let e = (s + batch).min(l.len());
-        brdf.eval_batch(&pts[s..e], &l[s..e], &v[s..e], &mut out[s..e]);
+        brdf.eval_points(&pts[s..e], &l[s..e], &v[s..e], &mut out[s..e]);
     }
     out
 }
 
 fn monte_carlo_group(
-    brdf: &impl BatchBrdf,
+    brdf: &impl SurfaceBrdf,
     pairs: &[(usize, EnergyPair)],
     samples: usize,
     seed: u64,
@@ -279,7 +279,7 @@ fn replica_estimate(s: &[[f64; 3]], m: usize) -> ([f64; 3], [f64; 3]) {
 }
 
 fn sobol_group(
-    brdf: &impl BatchBrdf,
+    brdf: &impl SurfaceBrdf,
     pairs: &[(usize, EnergyPair)],
     (replicas, initial, max_points, tol, z): (usize, usize, usize, f64, f64),
     seed: u64,
@@ -348,7 +348,7 @@ fn sobol_group(
 
 /// Estimates E(x, l) for every pair and summarises the violations (see the module doc).
 pub fn energy_conservation(
-    brdf: &impl BatchBrdf,
+    brdf: &impl SurfaceBrdf,
     pairs: &[EnergyPair],
     cfg: &EnergyConfig,
 ) -> Result<EnergyReport> {

@@ -12,11 +12,10 @@
 //! the tables' scaling convention ([`aggregate::TableScale`]).
 //!
 //! The BRDF analyses ([`energy`], [`reciprocity`]) take any model through the small
-//! [`BatchBrdf`] trait (batched, local frame), which analytic BRDFs get through
-//! [`AnalyticBatch`] and neural models implement in the experiments crate.
+//! [`brdf_analytic::SurfaceBrdf`] interface (batched over surface points, local frame), which
+//! every analytic BRDF is and `brdf-neural` implements for its models.
 
 pub mod aggregate;
-mod batch;
 pub mod colormap;
 pub mod energy;
 mod error;
@@ -31,7 +30,6 @@ pub mod ssim;
 #[doc(hidden)]
 pub mod testimg;
 
-pub use batch::{AnalyticBatch, BatchBrdf, FnBatch};
 pub use error::{Error, Result};
 pub use flip::{FlipConfig, FlipResult, hdr_flip, hdr_flip_with};
 pub use image::{Image, check_pair};

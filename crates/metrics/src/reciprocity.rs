@@ -1,13 +1,13 @@
 //! Reciprocity error (spec section 7): the RMSE between f(x, l, v) and f(x, v, l) over test pairs
 //! and RGB channels, the model evaluated with its inputs swapped. Not scaled in the tables.
 
-use crate::batch::BatchBrdf;
 use crate::error::{Error, Result};
+use brdf_analytic::SurfaceBrdf;
 use rayon::prelude::*;
 
 /// sqrt(mean over pairs and channels of (f(x, l, v) - f(x, v, l))^2), local-frame directions.
 pub fn reciprocity_rmse(
-    brdf: &impl BatchBrdf,
+    brdf: &impl SurfaceBrdf,
     points: &[u32],
     l: &[[f32; 3]],
     v: &[[f32; 3]],
@@ -23,8 +23,8 @@ pub fn reciprocity_rmse(
         let r = i * batch..((i + 1) * batch).min(l.len());
         let n = r.len();
         let (mut a, mut b) = (vec![[0.0f32; 3]; n], vec![[0.0f32; 3]; n]);
-        brdf.eval_batch(&points[r.clone()], &l[r.clone()], &v[r.clone()], &mut a);
-        brdf.eval_batch(&points[r.clone()], &v[r.clone()], &l[r], &mut b);
+        brdf.eval_points(&points[r.clone()], &l[r.clone()], &v[r.clone()], &mut a);
+        brdf.eval_points(&points[r.clone()], &v[r.clone()], &l[r], &mut b);
         a.iter()
             .zip(&b)
             .flat_map(|(p, q)| (0..3).map(move |c| (p[c] as f64 - q[c] as f64).powi(2)))
@@ -45,7 +45,7 @@ pub fn reciprocity_rmse(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::batch::{AnalyticBatch, FnBatch};
+    use brdf_analytic::FnSurface;
     use brdf_analytic::{Disney, DisneyParams, TorranceSparrow, TorranceSparrowParams};
 
     fn pairs(n: usize) -> (Vec<u32>, Vec<[f32; 3]>, Vec<[f32; 3]>) {
@@ -66,7 +66,7 @@ mod tests {
     #[test]
     fn exactly_zero_for_the_theta_mapping() {
         // Any (nonlinear) function of the reciprocal Theta mapping is exactly reciprocal.
-        let f = FnBatch(|_p: u32, l: [f32; 3], v: [f32; 3]| {
+        let f = FnSurface(|_p: u32, l: [f32; 3], v: [f32; 3]| {
             let t = angles::reciprocal_theta(l, v);
             [t[0].sin() * t[2].cos() + 0.1, (t[1] * t[3]).exp(), t[2].mul_add(t[0], t[1]).tanh()]
         });
@@ -77,8 +77,8 @@ mod tests {
     #[test]
     fn symmetric_parametric_models_are_zero() {
         let (p, l, v) = pairs(5000);
-        let d = AnalyticBatch(Disney::new(DisneyParams { roughness: 0.3, ..Default::default() }));
-        let t = AnalyticBatch(TorranceSparrow::new(TorranceSparrowParams::<f32>::default()));
+        let d = Disney::new(DisneyParams { roughness: 0.3, ..Default::default() });
+        let t = TorranceSparrow::new(TorranceSparrowParams::<f32>::default());
         assert_eq!(reciprocity_rmse(&d, &p, &l, &v).unwrap(), 0.0);
         assert_eq!(reciprocity_rmse(&t, &p, &l, &v).unwrap(), 0.0);
     }
@@ -86,7 +86,7 @@ mod tests {
     #[test]
     fn non_reciprocal_closure_hand_computed() {
         // f = (l_z, 0, 0): the swap difference is l_z - v_z in one channel of three.
-        let f = FnBatch(|_p: u32, l: [f32; 3], _v: [f32; 3]| [l[2], 0.0, 0.0]);
+        let f = FnSurface(|_p: u32, l: [f32; 3], _v: [f32; 3]| [l[2], 0.0, 0.0]);
         let (p, l, v) = pairs(1000);
         let want =
             (l.iter().zip(&v).map(|(a, b)| (a[2] as f64 - b[2] as f64).powi(2)).sum::<f64>()

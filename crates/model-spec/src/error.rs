@@ -13,6 +13,9 @@ pub enum Error {
     /// A model name that is neither a configuration name nor a paper table row.
     #[error("unknown model name {0:?} (see ModelKind::ALL for the names)")]
     UnknownModel(String),
+    /// A backend name other than cpu, flex, ndarray, wgpu or cuda.
+    #[error("unknown backend {0:?} (expected cpu, flex, ndarray, wgpu or cuda)")]
+    UnknownBackend(String),
 }
 
 /// `Result` with this crate's [`Error`].

@@ -2,8 +2,8 @@
 //! decisions table), without tensors: which models there are ([`ModelKind`]), how one is
 //! configured ([`ModelConfig`], serde, TOML), the direction features of the purely neural
 //! models ([`features`]: angle parametrizations, reciprocity options, positional encoding,
-//! computed on the CPU), and the layer tables every model is built from ([`MlpConfig`], one
-//! [`layers`]). brdf-neural builds and trains the models on burn from these
+//! computed on the CPU), the layer tables every model is built from ([`MlpConfig`], one
+//! [`layers`]), and the names of the backends and product precisions ([`backend`]). brdf-neural builds and trains the models on burn from these
 //! tables and re-exports every item under its old path; crates that only name models (the
 //! report's tables) depend on this crate and compile no tensor library.
 //!
@@ -42,6 +42,7 @@
 //! | Enh. Add. Sep. | 187,785 | 189,577 | 131,593 |
 //! | Enh. Add. Shared | 160,521 | 161,417 | 173,065 |
 
+pub mod backend;
 pub mod config;
 mod error;
 pub mod features;
@@ -49,6 +50,7 @@ pub mod kind;
 pub mod layers;
 pub mod mlp;
 
+pub use backend::{Backend, MatmulPrecision};
 pub use config::ModelConfig;
 pub use error::{Error, Result};
 pub use features::{AngleConfig, AngleParametrization, Reciprocity};

@@ -1,4 +1,4 @@
-//! A fitted run (`experiments::eval::FittedRun`): its model evaluated at surface points and
+//! A fitted run (`experiments::fitted::FittedRun`): its model evaluated at surface points and
 //! directions, and its exports.
 //!
 //! A surface point is a triangle of the scene's mesh and barycentrics `(b1, b2)` of the hit
@@ -10,10 +10,10 @@
 use crate::arrays::{as_vec3, flat, rows, same_len, to_array2};
 use crate::scene_dir::samples_dict;
 use angles::Frame;
+use brdf_neural::fitted::{PointRows, Records, predict};
 use experiments::data::spatial_features;
-use experiments::eval::FittedRun;
-use experiments::eval::predict::{CHUNK, forward_rows};
 use experiments::export::SurfacePoint;
+use experiments::fitted::FittedRun;
 use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyIndexError, PyOSError, PyValueError};
 use pyo3::prelude::*;
@@ -118,7 +118,7 @@ impl Run {
         if let Some(n) = &nw {
             lens.push(("normal", n.len()));
         }
-        let n = same_len(&lens)?;
+        same_len(&lens)?;
         let samples = self.points(tri, bary)?;
         let (l, v) = match &nw {
             None => (lw, vw),
@@ -134,25 +134,11 @@ impl Run {
         let r = &self.run;
         let spatial = spatial_features(&r.dataset, &samples, &r.config.features, &r.cache)
             .map_err(run_error)?;
-        let mut f = Vec::with_capacity(n);
-        let mut split_parts: [Option<Vec<[f32; 3]>>; 3] = [None, None, None];
-        for start in (0..n).step_by(CHUNK) {
-            let end = (start + CHUNK).min(n);
-            let mut rows_ = Vec::with_capacity((end - start) * spatial.dim);
-            for &p in &spatial.point[start..end] {
-                let p = p as usize;
-                rows_.extend_from_slice(&spatial.table[p * spatial.dim..(p + 1) * spatial.dim]);
-            }
-            let s = brdf_neural::Samples { spatial: &rows_, l: &l[start..end], v: &v[start..end] };
-            let p =
-                forward_rows(&r.model, &r.config.model, &s, &r.device, parts).map_err(run_error)?;
-            f.extend(p.f);
-            for (dst, src) in split_parts.iter_mut().zip([p.diffuse, p.diffuse_raw, p.specular]) {
-                if let Some(src) = src {
-                    dst.get_or_insert_with(Vec::new).extend(src);
-                }
-            }
-        }
+        let points = PointRows { spatial: &spatial.table, dim: spatial.dim, point: &spatial.point };
+        let records = Records { points, l: &l, v: &v };
+        let p = predict(&r.model, &r.config.model, records, &r.device, parts)
+            .map_err(|e| run_error(e.into()))?;
+        let (f, split_parts) = (p.f, [p.diffuse, p.diffuse_raw, p.specular]);
         if !parts {
             return Ok(to_array2(py, &f).into_any());
         }
@@ -197,9 +183,7 @@ impl Run {
         let paths = py
             .detach(|| {
                 let out = run_format::RunDir::new(&out);
-                experiments::export::portable::write(
-                    &out, &weights, &r.config, &r.dataset, &r.cache,
-                )
+                experiments::portable::write(&out, &weights, &r.config, &r.dataset, &r.cache)
             })
             .map_err(run_error)?;
         Ok(paths.to_vec())

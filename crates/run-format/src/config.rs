@@ -7,7 +7,7 @@
 //! seed = 1
 //! profile = "quick"          # quick | cpu | full: defaults for [train]
 //!
-//! [model]                    # brdf_neural::ModelConfig
+//! [model]                    # model_spec::ModelConfig
 //! kind = "single_mlp"
 //!
 //! [features]
@@ -24,8 +24,7 @@
 
 pub use crate::train_config::{OutputInit, Profile, Schedule, TrainConfig};
 use crate::{Error, Result};
-use brdf_neural::ModelConfig;
-use mesh_encoding::LboEncodingConfig;
+use model_spec::ModelConfig;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -98,6 +97,10 @@ pub struct LboSelection {
     pub max_basis_factor: f64,
 }
 
+/// The eigensolver's default basis limit (mesh-encoding's `EigenSettings::max_basis_factor`;
+/// experiments' tests hold the two equal).
+pub const DEFAULT_MAX_BASIS_FACTOR: f64 = 6.0;
+
 impl Default for LboSelection {
     fn default() -> Self {
         Self {
@@ -105,24 +108,33 @@ impl Default for LboSelection {
             first: 64,
             blocks: 6,
             block_len: 16,
-            max_basis_factor: mesh_encoding::EigenSettings::default().max_basis_factor,
+            max_basis_factor: DEFAULT_MAX_BASIS_FACTOR,
         }
     }
 }
 
 impl LboSelection {
-    /// The encoding configuration (validated first).
-    pub fn encoding(&self) -> Result<LboEncodingConfig> {
+    /// The eigenfunction indices: `0..first`, then `blocks` blocks of `block_len` whose starts
+    /// are `round(linspace(first, k_max - block_len, blocks))` (numpy's rounding, half to
+    /// even), so the last block ends at `k_max - 1` (validated first). The default gives
+    /// 0..64 and blocks at 64, 150, 237, 323, 410, 496: 160 indices, the last 511.
+    pub fn indices(&self) -> Result<Vec<usize>> {
         self.validate()?;
-        Ok(LboEncodingConfig {
-            selection: mesh_encoding::lbo::encoding::block_selection(
-                self.first,
-                self.blocks,
-                self.block_len,
-                self.k_max,
-            ),
-            ..LboEncodingConfig::default()
-        })
+        let mut out: Vec<usize> = (0..self.first).collect();
+        if self.blocks == 0 {
+            return Ok(out);
+        }
+        let (first, last) = (self.first as f64, (self.k_max - self.block_len) as f64);
+        for b in 0..self.blocks {
+            let start = if self.blocks == 1 {
+                first
+            } else {
+                first + (last - first) * b as f64 / (self.blocks - 1) as f64
+            };
+            let start = start.round_ties_even() as usize;
+            out.extend(start..start + self.block_len);
+        }
+        Ok(out)
     }
 
     /// Feature count.

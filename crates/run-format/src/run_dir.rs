@@ -66,7 +66,7 @@ impl RunDir {
         self.0.join("weights.bpk")
     }
 
-    /// `model.safetensors`: the final weights for other tools (`export::portable`).
+    /// `model.safetensors`: the final weights for other tools (experiments' `portable`).
     pub fn portable_weights(&self) -> PathBuf {
         self.0.join("model.safetensors")
     }
@@ -287,7 +287,7 @@ pub struct RunMetrics {
     pub phases: Option<crate::phases::StepPhases>,
     /// The burn backend that trained the run (absent in runs trained before it was recorded).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub backend: Option<brdf_neural::device::Backend>,
+    pub backend: Option<model_spec::Backend>,
     /// Seconds from the start of the last process's fit to the end of its first step (every
     /// kernel of the step launched, its loss read): reading the scene and its caches, making
     /// the device and its tables, and on a GPU compiling (or loading from the persistent

@@ -57,16 +57,16 @@
 //! 600 steps). `docs/reproduce.md` gives the measurements that chose these values. The regulariser
 //! weights are the paper's (enhanced split, spec 4.5) and apply to the enhanced additive
 //! models only. `output_init = "data"` starts every model's output layer (FMBRDF's excepted) at the
-//! least-squares constant BRDF of the training records (experiments' `TrainingData::mean_brdf`),
+//! least-squares constant BRDF of the training records (experiments' `RecordSet::mean_brdf`),
 //! so that an untrained model renders at the right brightness; `adam_epsilon` defaults to
 //! PyTorch's 1e-8 (burn's own default, 1e-5, damps every update whose gradient is that small).
 //! `matmul_precision = "bf16"` trains with the network's large matrix products on bf16 operands
-//! and f32 sums ([`brdf_neural::precision`]: flex on the CPU, cuda on tensor cores; evaluation
+//! and f32 sums (brdf-neural's `precision`: flex on the CPU, cuda on tensor cores; evaluation
 //! stays f32);
 //! `docs/reproduce.md` gives its measured speed and what it does to the converged scores.
 
 use crate::{Error, Result};
-use brdf_neural::precision::MatmulPrecision;
+use model_spec::MatmulPrecision;
 use serde::{Deserialize, Serialize};
 
 /// Which defaults a run starts from.

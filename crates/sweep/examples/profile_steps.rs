@@ -69,7 +69,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     };
     let steps: u64 = rest.first().map_or(Ok(300), |s| s.parse())?;
-    let backend = brdf_neural::device::Backend::parse(rest.get(1).map_or("cpu", String::as_str))?;
+    let backend = brdf_neural::device::parse_backend(rest.get(1).map_or("cpu", String::as_str))?;
     let only: Option<Vec<&str>> = rest.get(2).map(|m| m.split(',').map(str::trim).collect());
     let eval_list = std::env::var("PROFILE_EVAL").ok();
     let eval_repeat: u32 = std::env::var("PROFILE_EVAL_REPEAT").map_or(Ok(1), |v| v.parse())?;

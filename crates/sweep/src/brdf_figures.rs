@@ -29,7 +29,7 @@ fn ground_truth_probe(scene: &Path) -> Option<BrdfProbe> {
     let manifest = scene::Manifest::read(&scene.join(scene::MANIFEST_FILE)).ok()?;
     let (_, gt) = dataset_merl::generate::ground_truth(&manifest.config).ok()?;
     let f64s = |d: [f32; 3]| d.map(f64::from);
-    let brdf = metrics::FnBatch(move |_: u32, l: [f32; 3], v: [f32; 3]| {
+    let brdf = brdf_analytic::FnSurface(move |_: u32, l: [f32; 3], v: [f32; 3]| {
         gt(f64s(l), f64s(v)).unwrap_or([0.0; 3]).map(|x| x as f32)
     });
     Some(probe::probe(&brdf, 0, String::new(), None))

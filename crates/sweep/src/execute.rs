@@ -14,7 +14,7 @@ use super::shell;
 use super::timing::SweepTiming;
 use brdf_neural::device::Backend;
 use dataset_merl::generate_scene;
-use experiments::eval::fitted::FittedRun;
+use experiments::fitted::FittedRun;
 use experiments::train::fit_and_keep;
 use experiments::{Error, FitOptions, FitOutcome, Result};
 use run_format::config::SpatialKind;

@@ -363,7 +363,7 @@ fn observed_png(
         return Ok(Some(path));
     }
     let Ok((w, h, px)) = scene::images::read_exr_rgb(&exr) else { return Ok(None) };
-    experiments::eval::images::write_png_srgb(&path, w as u32, h as u32, &px)?;
+    experiments::eval::images::write_png_srgb_atomic(&path, w as u32, h as u32, &px)?;
     summary.files.push(path.clone());
     Ok(Some(path))
 }

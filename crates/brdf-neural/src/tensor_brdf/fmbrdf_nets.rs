@@ -6,6 +6,7 @@
 //! through them to their inputs (alpha, beta, eta, kappa).
 
 use super::lambda_segments::Segments;
+use crate::precision::PrecisionScope;
 use burn::module::Module;
 use burn::tensor::activation::{relu, softplus};
 use burn::tensor::{Device, Int, Tensor, TensorData};

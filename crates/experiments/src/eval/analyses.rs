@@ -1,21 +1,23 @@
 //! The BRDF-space analyses of a fitted model on its test records (spec section 7): energy
 //! conservation (directional albedo of random (x, l) pairs) and the reciprocity RMSE.
 
-use super::predict::ModelBrdf;
 use crate::Result;
+use crate::data::RecordSet;
+use brdf_analytic::SurfaceBrdf;
 use metrics::energy::{EnergyConfig, EnergyPair, energy_conservation, sample_pairs};
 use run_format::EnergySummary;
 use run_format::eval_config::EvalSettings;
 
-/// Runs the configured energy analysis on `pairs` random test records (`None` when off).
+/// Runs the configured energy analysis of `brdf` on `pairs` random records of `data` (point `i`
+/// of `brdf` is record `i`; `None` when off).
 pub fn energy(
-    brdf: &ModelBrdf,
+    brdf: &impl SurfaceBrdf,
+    data: &RecordSet,
     settings: &EvalSettings,
     seed: u64,
     progress: bool,
 ) -> Result<Option<EnergySummary>> {
     let Some(estimator) = settings.energy else { return Ok(None) };
-    let data = brdf.data();
     if data.is_empty() {
         return Ok(None);
     }
@@ -36,10 +38,13 @@ pub fn energy(
     }))
 }
 
-/// The reciprocity RMSE over the first `settings.reciprocity_pairs` test records spread over
-/// the whole set (every k-th), `None` when off.
-pub fn reciprocity(brdf: &ModelBrdf, settings: &EvalSettings) -> Result<Option<f64>> {
-    let data = brdf.data();
+/// The reciprocity RMSE of `brdf` over `settings.reciprocity_pairs` records of `data` spread
+/// over the whole set (every k-th; point `i` of `brdf` is record `i`), `None` when off.
+pub fn reciprocity(
+    brdf: &impl SurfaceBrdf,
+    data: &RecordSet,
+    settings: &EvalSettings,
+) -> Result<Option<f64>> {
     let n = settings.reciprocity_pairs.min(data.len());
     if n == 0 {
         return Ok(None);

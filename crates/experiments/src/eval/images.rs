@@ -41,9 +41,9 @@
 //!                                           averaged over the view's lit test samples
 //! ```
 
-use super::predict::Prediction;
-use crate::data::TrainingData;
+use crate::data::RecordSet;
 use crate::{Error, Result};
+use brdf_neural::fitted::Prediction;
 use indicatif::ProgressBar;
 use metrics::Image;
 use metrics::lpips::Lpips;
@@ -88,7 +88,7 @@ fn write_exr_rgb(path: &Path, width: usize, height: usize, rgb: &[[f32; 3]]) -> 
 }
 
 /// Writes a linear RGB image as an 8-bit sRGB PNG atomically.
-pub fn write_png_srgb(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<()> {
+pub fn write_png_srgb_atomic(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<()> {
     Ok(stdx::fs::write_atomic(path, &png_srgb_bytes(path, width, height, rgb)?)?)
 }
 
@@ -196,19 +196,11 @@ pub struct RenderOptions<'a> {
     pub skip_ceiling: bool,
 }
 
-/// The clip level renders get: the saturation of semi-synthetic scenes, none for captures
-/// (whose observations are raw values divided by a per-light intensity).
-pub fn clip_level(dataset: &SceneDataset) -> Option<f32> {
-    use scene::MaterialSpec;
-    let c = &dataset.manifest.config;
-    (!matches!(c.material, MaterialSpec::Captured { .. })).then_some(c.settings.saturation)
-}
-
 /// Renders every test pair, writes the images (when `opts.write`) and returns the mean metrics.
 pub fn render_and_score(
     dataset: &SceneDataset,
     samples: &SampleSet,
-    data: &TrainingData,
+    data: &RecordSet,
     pred: &Prediction,
     opts: &RenderOptions<'_>,
 ) -> Result<ImageScores> {
@@ -262,7 +254,7 @@ pub fn render_and_score(
             for (name, part) in [("diffuse", &pred.diffuse), ("specular", &pred.specular)] {
                 if let Some(part) = part {
                     let path = out.renders.join(format!("{stem}_{name}.png"));
-                    write_png_srgb(&path, w as u32, h as u32, &render(part))?;
+                    write_png_srgb_atomic(&path, w as u32, h as u32, &render(part))?;
                 }
             }
         }
@@ -330,7 +322,7 @@ struct PairScores {
 pub fn mean_psnr(
     dataset: &SceneDataset,
     samples: &SampleSet,
-    data: &TrainingData,
+    data: &RecordSet,
     f: &[[f32; 3]],
 ) -> Result<f64> {
     let t = TestImages::new(dataset, samples, data);
@@ -352,7 +344,7 @@ pub fn mean_psnr(
 pub fn psnr_between(
     dataset: &SceneDataset,
     samples: &SampleSet,
-    data: &TrainingData,
+    data: &RecordSet,
     f: &[[f32; 3]],
     reference: &[[f32; 3]],
 ) -> Result<Vec<f64>> {
@@ -372,7 +364,7 @@ pub fn psnr_between(
 struct TestImages<'a> {
     dataset: &'a SceneDataset,
     samples: &'a SampleSet,
-    data: &'a TrainingData,
+    data: &'a RecordSet,
     width: usize,
     height: usize,
     pairs: Vec<(usize, usize)>,
@@ -381,7 +373,7 @@ struct TestImages<'a> {
 }
 
 impl<'a> TestImages<'a> {
-    fn new(dataset: &'a SceneDataset, samples: &'a SampleSet, data: &'a TrainingData) -> Self {
+    fn new(dataset: &'a SceneDataset, samples: &'a SampleSet, data: &'a RecordSet) -> Self {
         let s = &dataset.manifest.config.settings;
         let mut by_pair: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
         for (r, &i) in data.source.iter().enumerate() {
@@ -396,7 +388,7 @@ impl<'a> TestImages<'a> {
             height: s.height as usize,
             pairs: dataset.pairs(Split::Test),
             by_pair,
-            clip: clip_level(dataset),
+            clip: crate::data::clip_level(dataset),
         }
     }
 
@@ -461,7 +453,7 @@ impl OutputDirs {
         mask: &[bool],
     ) -> Result<()> {
         write_exr_rgb(&self.renders.join(format!("{stem}.exr")), w, h, img)?;
-        write_png_srgb(&self.renders.join(format!("{stem}.png")), w as u32, h as u32, img)?;
+        write_png_srgb_atomic(&self.renders.join(format!("{stem}.png")), w as u32, h as u32, img)?;
         let map = metrics::colormap::error_map_rgb8(flip_map, Some(mask));
         write_png_rgb8(&self.flips.join(format!("{stem}.png")), w, h, &map)
     }
@@ -493,7 +485,12 @@ impl AlbedoMaps {
                 .zip(&count)
                 .map(|(s, &n)| if n > 0 { s.map(|x| x / n as f32) } else { [0.0; 3] })
                 .collect();
-            write_png_srgb(&dir.join(format!("view{vi:03}.png")), w as u32, h as u32, &mean)?;
+            write_png_srgb_atomic(
+                &dir.join(format!("view{vi:03}.png")),
+                w as u32,
+                h as u32,
+                &mean,
+            )?;
         }
         Ok(())
     }

@@ -8,10 +8,8 @@
 //! * [`metric_settings`] (run-format's): the exact settings of each protocol, written beside
 //!   the scores.
 //! * [`analyses`]: energy conservation and the reciprocity RMSE on the test records.
-//! * [`predict`](mod@predict): the model on CPU records, and as a [`metrics::BatchBrdf`].
 //! * [`probe`]: the model on the BRDF plots' fixed directions (lit sphere, slices, albedo
 //!   against angle, validity maps), stored as `<run>/probe.bin` when images are written.
-//! * [`fitted`]: a finished run opened for analysis (config, model, scene).
 //! * [`run_format::eval_config`]: the `[eval]` table of the run configuration.
 //!
 //! The cube-root RMSE runs over the lit test samples with theta_l, theta_v <= 80 degrees, not
@@ -20,16 +18,15 @@
 //! `lpips_unavailable` says why. Results go into `<run>/metrics.json` under `test`.
 
 pub mod analyses;
-pub mod fitted;
 pub mod images;
-pub mod predict;
 pub mod probe;
 
-pub use fitted::FittedRun;
-pub use predict::{ModelBrdf, Prediction, predict, predict_on};
+pub use crate::fitted::FittedRun;
+pub use brdf_neural::fitted::Prediction;
 
 use crate::Result;
-use crate::data::TrainingData;
+use crate::data::RecordSet;
+use brdf_neural::fitted::{NeuralSurface, device_table, predict, predict_on};
 use metrics::rmse::{CubeRootRmse, RmseConfig};
 use run_format::metric_settings;
 use run_format::phases::EvalPhases;
@@ -58,15 +55,15 @@ pub fn energy_of_run(
     let settings = eval.resolve(run.config.train.profile);
     let (_, data) = run.test_records()?;
     let config = &run.config;
-    let brdf = ModelBrdf::new(&run.model, &config.model, &data, &run.device)?;
-    analyses::energy(&brdf, &settings, config.seed, progress)
+    let brdf = NeuralSurface::new(&run.model, &config.model, data.points(), &run.device)?;
+    analyses::energy(&brdf, &data, &settings, config.seed, progress)
 }
 
 /// The cube-root RMSE of the predictions `f` (one per record of `data`) over the samples with
 /// a valid ground truth, and the number of samples kept.
 pub fn cube_root_rmse(
     samples: &SampleSet,
-    data: &TrainingData,
+    data: &RecordSet,
     f: &[[f32; 3]],
 ) -> Result<(Option<f64>, usize)> {
     let mut rmse = CubeRootRmse::new(RmseConfig::default());
@@ -129,15 +126,16 @@ fn snapshot_curve(
     fitted: &FittedRun,
     run: &Path,
     snapshots: &[Snapshot],
-    (samples, data): (&SampleSet, &TrainingData),
+    (samples, data): (&SampleSet, &RecordSet),
 ) -> Result<Vec<CurvePoint>> {
     let mut out = Vec::with_capacity(snapshots.len());
     let gpu = !brdf_neural::device::is_cpu_device(&fitted.device);
-    let table = crate::trainer::device_table(&fitted.config.model, data, gpu, &fitted.device)?;
+    let table = device_table(&fitted.config.model, data.points(), gpu, &fitted.device)?;
     for s in snapshots {
         let model = fitted.load_weights_file(&RunDir::new(run).snapshot(s.step))?;
         let config = &fitted.config.model;
-        let pred = predict_on(&model, config, data, table.as_ref(), &fitted.device, false)?;
+        let records = data.records();
+        let pred = predict_on(&model, config, records, table.as_ref(), &fitted.device, false)?;
         let psnr = images::mean_psnr(&fitted.dataset, samples, data, &pred.f)?;
         let (rmse_cbrt, _) = cube_root_rmse(samples, data, &pred.f)?;
         out.push(CurvePoint { step: s.step, seconds: s.seconds, psnr, rmse_cbrt });
@@ -179,7 +177,7 @@ pub fn eval_fitted(
     let (samples, data) = fitted.test_records()?;
     charge(&mut phases.records);
     let parts = config.model.kind.is_additive() && settings.images;
-    let pred = predict(model, &config.model, &data, device, parts)?;
+    let pred = predict(model, &config.model, data.records(), device, parts)?;
     let (rmse_cbrt, rmse_samples) = cube_root_rmse(&samples, &data, &pred.f)?;
     charge(&mut phases.predict);
 
@@ -206,10 +204,10 @@ pub fn eval_fitted(
     }
     drop(writer);
     charge(&mut phases.images);
-    let brdf = ModelBrdf::new(model, &config.model, &data, device)?;
-    let reciprocity_rmse = analyses::reciprocity(&brdf, &settings)?;
+    let brdf = NeuralSurface::new(model, &config.model, data.points(), device)?;
+    let reciprocity_rmse = analyses::reciprocity(&brdf, &data, &settings)?;
     charge(&mut phases.reciprocity);
-    let energy = analyses::energy(&brdf, &settings, config.seed, progress)?;
+    let energy = analyses::energy(&brdf, &data, &settings, config.seed, progress)?;
     charge(&mut phases.energy);
     if settings.images
         && let Some(p) = probe::probe_fitted(&brdf, dataset, &samples, &data)
@@ -247,7 +245,7 @@ pub fn eval_fitted(
         settings: Some(metric_settings::MetricSettings::current(
             scores.images,
             scores.pixels,
-            images::clip_level(dataset),
+            crate::data::clip_level(dataset),
         )),
         seconds: start.elapsed().as_secs_f64(),
         phases,

@@ -1,5 +1,5 @@
 //! The BRDF probes behind the report's BRDF plots (`report::brdf_plots`): any
-//! [`metrics::BatchBrdf`] (a fitted model, or the ground-truth material of a semi-synthetic
+//! [`brdf_analytic::SurfaceBrdf`] (a fitted model, or the ground-truth material of a semi-synthetic
 //! scene) evaluated on fixed direction sets, so that models can be compared with each other and
 //! with the truth away from the directions the cameras saw.
 //!
@@ -15,10 +15,10 @@
 //! is `pi / N * sum f(l_k, v)` over stratified cosine-weighted `l_k` with fixed jitter, so a
 //! probe is deterministic. The result of a run is stored as `<run>/probe.bin` ([`write`](fn@write)).
 
-use crate::data::TrainingData;
+use crate::data::RecordSet;
 use crate::{Error, Result};
 use angles::Frame;
-use metrics::BatchBrdf;
+use brdf_analytic::SurfaceBrdf;
 use metrics::energy::cosine_direction;
 use report::brdf_plots::{
     AlbedoPoint, BrdfProbe, LitSphere, PolarSlice, SPHERE_SIZE, ValidityMaps, sphere_normal,
@@ -59,7 +59,7 @@ pub fn stratified_cosine(n: usize) -> Vec<[f32; 3]> {
 /// `brdf` at `point` for every (l, v) pair, in the batches the BRDF prefers; non-finite
 /// values become 0 (the plots show what is finite; the analyses reject NaN elsewhere).
 pub fn eval_pairs(
-    brdf: &dyn BatchBrdf,
+    brdf: &dyn SurfaceBrdf,
     points: &[u32],
     l: &[[f32; 3]],
     v: &[[f32; 3]],
@@ -68,7 +68,7 @@ pub fn eval_pairs(
     let chunk = brdf.preferred_batch().max(1);
     for (k, o) in out.chunks_mut(chunk).enumerate() {
         let r = k * chunk..k * chunk + o.len();
-        brdf.eval_batch(&points[r.clone()], &l[r.clone()], &v[r], o);
+        brdf.eval_points(&points[r.clone()], &l[r.clone()], &v[r], o);
     }
     for c in out.iter_mut().flatten() {
         if !c.is_finite() {
@@ -81,7 +81,7 @@ pub fn eval_pairs(
 /// Directional albedo for the view directions `v` (local), each at its point, by
 /// [`stratified_cosine`] with `strata`^2 directions.
 pub fn directional_albedo(
-    brdf: &dyn BatchBrdf,
+    brdf: &dyn SurfaceBrdf,
     points: &[u32],
     v: &[[f32; 3]],
     strata: usize,
@@ -113,7 +113,7 @@ fn to_f32(v: [f64; 3]) -> [f32; 3] {
 }
 
 /// The BRDF at `point` on a sphere lit by [`SPHERE_LIGHT`].
-pub fn lit_sphere(brdf: &dyn BatchBrdf, point: u32) -> LitSphere {
+pub fn lit_sphere(brdf: &dyn SurfaceBrdf, point: u32) -> LitSphere {
     let size = SPHERE_SIZE as usize;
     let (mut idx, mut ll, mut vv, mut cos) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for i in 0..size * size {
@@ -137,7 +137,7 @@ pub fn lit_sphere(brdf: &dyn BatchBrdf, point: u32) -> LitSphere {
 }
 
 /// The BRDF at `point` on the slices of [`INCIDENT_DEG`].
-pub fn slices(brdf: &dyn BatchBrdf, point: u32) -> Vec<PolarSlice> {
+pub fn slices(brdf: &dyn SurfaceBrdf, point: u32) -> Vec<PolarSlice> {
     let outgoing: Vec<f64> = (-89..=89).map(f64::from).collect();
     INCIDENT_DEG
         .iter()
@@ -160,7 +160,7 @@ pub fn slices(brdf: &dyn BatchBrdf, point: u32) -> Vec<PolarSlice> {
 }
 
 /// Directional albedo at `point` against the viewing angle, 0..=88 degrees.
-pub fn albedo_curve(brdf: &dyn BatchBrdf, point: u32) -> Vec<AlbedoPoint> {
+pub fn albedo_curve(brdf: &dyn SurfaceBrdf, point: u32) -> Vec<AlbedoPoint> {
     let angles: Vec<f64> = (0..=44).map(|i| 2.0 * i as f64).collect();
     let v: Vec<[f32; 3]> = angles
         .iter()
@@ -175,7 +175,7 @@ pub fn albedo_curve(brdf: &dyn BatchBrdf, point: u32) -> Vec<AlbedoPoint> {
 
 /// Every probe of `brdf` at `point` (`at` says where that is), with `validity` maps.
 pub fn probe(
-    brdf: &dyn BatchBrdf,
+    brdf: &dyn SurfaceBrdf,
     point: u32,
     at: String,
     validity: Option<ValidityMaps>,
@@ -194,7 +194,7 @@ pub fn probe(
 pub fn first_test_view(
     dataset: &SceneDataset,
     samples: &SampleSet,
-    data: &TrainingData,
+    data: &RecordSet,
 ) -> Option<(usize, Vec<Option<u32>>)> {
     let &(vi, _) = dataset.pairs(Split::Test).first()?;
     let s = &dataset.manifest.config.settings;
@@ -228,8 +228,8 @@ pub fn centre_record(pixels: &[Option<u32>], width: usize) -> Option<u32> {
 /// The validity maps of `brdf` (points are records of `data`) on test view `view`, whose
 /// pixels map to records by `pixels`.
 pub fn validity_maps(
-    brdf: &dyn BatchBrdf,
-    data: &TrainingData,
+    brdf: &dyn SurfaceBrdf,
+    data: &RecordSet,
     view: usize,
     pixels: &[Option<u32>],
     width: u32,
@@ -263,10 +263,10 @@ pub fn validity_maps(
 /// The probe of a fitted model on its test records: at the point nearest the centre of the
 /// first test view, with that view's validity maps; `None` without test records.
 pub fn probe_fitted(
-    brdf: &dyn BatchBrdf,
+    brdf: &dyn SurfaceBrdf,
     dataset: &SceneDataset,
     samples: &SampleSet,
-    data: &TrainingData,
+    data: &RecordSet,
 ) -> Option<BrdfProbe> {
     let (view, pixels) = first_test_view(dataset, samples, data)?;
     let width = dataset.manifest.config.settings.width;
@@ -295,13 +295,12 @@ pub fn read(path: &Path) -> Result<BrdfProbe> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use metrics::{AnalyticBatch, FnBatch};
+    use brdf_analytic::FnSurface;
 
     #[test]
     fn a_white_lambertian_has_albedo_one_everywhere_and_a_cosine_sphere() {
-        let white = AnalyticBatch(brdf_analytic::Lambert::new(brdf_analytic::LambertParams {
-            albedo: [1.0f32; 3],
-        }));
+        let white =
+            brdf_analytic::Lambert::new(brdf_analytic::LambertParams { albedo: [1.0f32; 3] });
         let curve = albedo_curve(&white, 0);
         assert_eq!(curve.len(), 45);
         for (t, a) in &curve {
@@ -332,15 +331,15 @@ mod tests {
     #[test]
     fn reciprocity_maps_see_an_asymmetric_brdf_and_nan_is_contained() {
         // f = 1 + l_z (not reciprocal); NaN at one point.
-        let brdf = FnBatch(
+        let brdf = FnSurface(
             |p: u32, l: [f32; 3], _v: [f32; 3]| {
                 if p == 2 { [f32::NAN; 3] } else { [1.0 + l[2]; 3] }
             },
         );
-        let data = TrainingData {
+        let data = RecordSet {
             l: vec![[0.0, 0.0, 1.0], [0.6, 0.0, 0.8], [0.0, 0.0, 1.0]],
             v: vec![[0.6, 0.0, 0.8], [0.6, 0.0, 0.8], [0.0, 0.0, 1.0]],
-            ..TrainingData::default()
+            ..RecordSet::default()
         };
         let pixels = [Some(0), None, Some(1), Some(2)];
         let m = validity_maps(&brdf, &data, 4, &pixels, 2);
@@ -361,9 +360,8 @@ mod tests {
 
     #[test]
     fn probes_round_trip_through_their_file() {
-        let white = AnalyticBatch(brdf_analytic::Lambert::new(brdf_analytic::LambertParams {
-            albedo: [0.5f32; 3],
-        }));
+        let white =
+            brdf_analytic::Lambert::new(brdf_analytic::LambertParams { albedo: [0.5f32; 3] });
         let p = probe(&white, 0, "uniform".into(), None);
         let tmp = test_support::TempDir::new("probe");
         let path = tmp.0.join("probe.bin");

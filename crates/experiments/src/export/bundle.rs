@@ -14,7 +14,7 @@ use super::gltf::ExportMesh;
 use super::material::{ExportedMaterial, MaterialKind};
 use super::round_trip::{RoundTrip, round_trip};
 use super::{gltf, mitsuba, pbrt, test_pairs};
-use crate::eval::FittedRun;
+use crate::fitted::FittedRun;
 use crate::{Error, Result};
 use brdf_neural::BrdfModel;
 use run_format::run_dir::RunDir;
@@ -203,15 +203,18 @@ fn export_neural(
         let dir = tmp.join(dir_name);
         let weights = RunDir::new(run).weights();
         let portable = RunDir::new(&dir);
-        super::portable::write(
+        crate::portable::write(
             &portable,
             &weights,
             &fitted.config,
             &fitted.dataset,
             &fitted.cache,
         )?;
-        let mut written = mitsuba::write_scene(&dir, &mesh, &mitsuba::neural_bsdf(), &[], &pairs)?;
-        written.extend(["model.safetensors".to_string(), "model.json".to_string()]);
+        let mut written =
+            mitsuba::write_mitsuba_scenes(&dir, &mesh, &mitsuba::neural_bsdf(), &[], &pairs)?;
+        for file in [portable.portable_weights(), portable.portable_description()] {
+            written.extend(file.file_name().map(|n| n.to_string_lossy().into_owned()));
+        }
         let summary = ExportSummary {
             model: kind,
             uniform: false,

@@ -12,7 +12,7 @@
 //! c^2.2 here, which is what its BRDF uses.
 
 use super::vertex_features;
-use crate::eval::FittedRun;
+use crate::fitted::FittedRun;
 use crate::{Error, Result};
 use brdf_analytic::{Brdf, Disney, DisneyParams, TorranceSparrow, TorranceSparrowParams};
 use brdf_neural::{BrdfBatch, BrdfModel, BrdfParams, Samples};

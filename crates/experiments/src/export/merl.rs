@@ -11,14 +11,15 @@
 //! (Euclidean) to the mean over all vertices, i.e. the most "average" point of the object.
 
 use super::{SurfacePoint, representative_row, vertex_features};
-use crate::data::TrainingData;
-use crate::eval::{FittedRun, ModelBrdf};
+use crate::data::RecordSet;
+use crate::fitted::FittedRun;
 use crate::{Error, Result};
 use angles::Rusinkiewicz;
+use brdf_analytic::SurfaceBrdf;
+use brdf_neural::fitted::NeuralSurface;
 use dataset_merl::MerlBrdf;
 use dataset_merl::merl::format::TABLE_LEN;
 use dataset_merl::merl::lookup::bin_lower_edges;
-use metrics::BatchBrdf;
 use std::path::Path;
 
 /// What [`export_merl`] wrote.
@@ -37,7 +38,7 @@ pub struct MerlExport {
 /// Tabulates `brdf` at surface point `point` over every MERL bin; returns the table and the
 /// number of below-horizon bins (written as 0).
 pub fn tabulate_merl(
-    brdf: &impl BatchBrdf,
+    brdf: &impl SurfaceBrdf,
     point: u32,
     progress: bool,
 ) -> Result<(MerlBrdf, usize)> {
@@ -61,7 +62,7 @@ pub fn tabulate_merl(
     for start in (0..idx.len()).step_by(batch) {
         let end = (start + batch).min(idx.len());
         let n = end - start;
-        brdf.eval_batch(&points[..n], &ls[start..end], &vs[start..end], &mut out[..n]);
+        brdf.eval_points(&points[..n], &ls[start..end], &vs[start..end], &mut out[..n]);
         for (k, f) in out[..n].iter().enumerate() {
             if f.iter().any(|x| !x.is_finite()) {
                 let (l, v) = (ls[start + k], vs[start + k]);
@@ -103,13 +104,13 @@ pub fn export_merl(
         SurfacePoint::Representative => representative_row(&table, dim)
             .ok_or_else(|| Error::format(&dataset.dir, "the mesh has no vertices"))?,
     };
-    let data = TrainingData {
+    let data = RecordSet {
         spatial: std::sync::Arc::new(table[vertex * dim..(vertex + 1) * dim].to_vec()),
         spatial_dim: dim,
         point: vec![0],
         ..Default::default()
     };
-    let brdf = ModelBrdf::new(&fitted.model, &config.model, &data, &fitted.device)?;
+    let brdf = NeuralSurface::new(&fitted.model, &config.model, data.points(), &fitted.device)?;
     let (merl, below_horizon) = tabulate_merl(&brdf, 0, progress)?;
     merl.write(out).map_err(|e| Error::format(out, e.to_string()))?;
     Ok(MerlExport {
@@ -124,7 +125,6 @@ pub fn export_merl(
 mod tests {
     use super::*;
     use brdf_analytic::{Brdf, Disney, DisneyParams, TorranceSparrow, TorranceSparrowParams};
-    use metrics::AnalyticBatch;
 
     /// A "model" that wraps an analytic BRDF exports exactly that BRDF's MERL table (the
     /// f64 tabulation of the same BRDF), up to f32 evaluation.
@@ -144,7 +144,7 @@ mod tests {
             }
             assert!(worst < 1e-4, "{name}: worst relative difference {worst}");
         };
-        let (ours, below) = tabulate_merl(&AnalyticBatch(ts), 0, false).unwrap();
+        let (ours, below) = tabulate_merl(&ts, 0, false).unwrap();
         let reference = MerlBrdf::tabulate("ts", |h, d, p| {
             let (l, v) = Rusinkiewicz { theta_h: h, theta_d: d, phi_d: p }.to_local();
             if l[2] > 0.0 && v[2] > 0.0 {
@@ -161,7 +161,7 @@ mod tests {
         .unwrap();
         assert!(below > 0 && below < TABLE_LEN / 2, "{below}");
         check("Torrance-Sparrow", ours, reference);
-        let (ours, _) = tabulate_merl(&AnalyticBatch(disney), 0, false).unwrap();
+        let (ours, _) = tabulate_merl(&disney, 0, false).unwrap();
         let reference = MerlBrdf::tabulate("disney", |h, d, p| {
             let (l, v) = Rusinkiewicz { theta_h: h, theta_d: d, phi_d: p }.to_local();
             if l[2] > 0.0 && v[2] > 0.0 {

@@ -145,7 +145,7 @@ pub fn write(
     pairs: &[ExportPair],
 ) -> Result<Vec<String>> {
     let (bsdf, attrs) = principled(material);
-    write_scene(dir, mesh, &bsdf, &attrs, pairs)
+    write_mitsuba_scenes(dir, mesh, &bsdf, &attrs, pairs)
 }
 
 /// The BSDF element of a purely neural fit: the Python package's `neural_brdf` plugin
@@ -161,7 +161,7 @@ pub fn neural_bsdf() -> String {
 
 /// Writes `mesh.ply` (with `attrs`), `object.xml` (the mesh with `bsdf`) and one scene per
 /// test pair into `dir`; returns the file names.
-pub fn write_scene(
+pub fn write_mitsuba_scenes(
     dir: &Path,
     mesh: &ExportMesh<'_>,
     bsdf: &str,

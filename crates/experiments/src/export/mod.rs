@@ -3,7 +3,7 @@
 //! as a glTF 2.0 asset ([`gltf`]), a Mitsuba 3 scene ([`mitsuba`]) and a pbrt-v4 scene
 //! ([`pbrt`]), the last two with the scene's cameras and lights. [`round_trip`] re-renders the
 //! test views from an exported file with `brdf-analytic` and scores it against the fit's own
-//! renders. [`portable`] writes any fitted model's weights as safetensors with a JSON
+//! renders. [`crate::portable`] (written by every fit) holds any fitted model's weights as safetensors with a JSON
 //! description, for PyTorch and numpy users.
 //!
 //! Purely neural fits leave as MERL tables, and as Mitsuba 3 scenes whose `neural_brdf` BSDF
@@ -22,18 +22,14 @@ pub mod merl;
 pub mod mitsuba;
 pub mod pbrt;
 pub mod ply;
-pub mod portable;
 pub mod round_trip;
 
 pub use bundle::{ExportSummary, Format, export};
 pub use material::{ExportedMaterial, MaterialKind};
 pub use merl::{MerlExport, export_merl, tabulate_merl};
 
-use crate::Result;
-use crate::data::lbo_table;
-use run_format::config::{RunConfig, SpatialKind};
+pub use crate::data::vertex_features;
 use scene::SceneDataset;
-use std::path::Path;
 
 /// Which surface point the table describes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -43,21 +39,6 @@ pub enum SurfacePoint {
     Representative,
     /// A given vertex index.
     Vertex(usize),
-}
-
-/// The per-vertex spatial features `[vertices, dim]` of a scene's mesh under `config`.
-pub fn vertex_features(
-    scene: &SceneDataset,
-    config: &RunConfig,
-    cache: &Path,
-) -> Result<(Vec<f32>, usize)> {
-    match config.features.spatial {
-        SpatialKind::Lbo => lbo_table(scene, &config.features, cache),
-        SpatialKind::Position => {
-            Ok((scene.mesh.positions.iter().flat_map(|p| p.to_array()).collect(), 3))
-        }
-        SpatialKind::Uniform => Ok((vec![1.0; scene.mesh.positions.len()], 1)),
-    }
 }
 
 /// The row of `table` (`[n, dim]`) closest to the mean row.

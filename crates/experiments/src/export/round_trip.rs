@@ -8,10 +8,10 @@
 //! interpolated features, which the score then shows.
 
 use super::material::ExportedMaterial;
-use crate::eval::FittedRun;
 use crate::eval::images::psnr_between;
-use crate::eval::predict;
+use crate::fitted::FittedRun;
 use crate::{Error, Result};
+use brdf_neural::fitted::predict;
 use serde::{Deserialize, Serialize};
 
 /// The round trip's scores over the test pairs.
@@ -58,7 +58,8 @@ pub fn exported_brdf(fitted: &FittedRun, material: &ExportedMaterial) -> Result<
 /// Scores `material` (read back from an export) against the fit's renders.
 pub fn round_trip(fitted: &FittedRun, material: &ExportedMaterial) -> Result<RoundTrip> {
     let (samples, data) = fitted.test_records()?;
-    let fit = predict(&fitted.model, &fitted.config.model, &data, &fitted.device, false)?.f;
+    let records = data.records();
+    let fit = predict(&fitted.model, &fitted.config.model, records, &fitted.device, false)?.f;
     let ours = exported_brdf(fitted, material)?;
     let mut worst = 0.0f64;
     for (a, b) in ours.iter().zip(&fit) {

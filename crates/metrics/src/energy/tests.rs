@@ -3,7 +3,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::*;
-use crate::batch::{AnalyticBatch, FnBatch};
+use brdf_analytic::FnSurface;
 use brdf_analytic::{Brdf, Lambert, LambertParams, TorranceSparrow, TorranceSparrowParams};
 
 fn light(theta_deg: f32) -> [f32; 3] {
@@ -22,7 +22,7 @@ fn fast() -> EnergyConfig {
 #[test]
 fn lambert_gives_its_albedo_within_the_error_bar() {
     let a = [0.2f32, 0.55, 0.9];
-    let brdf = AnalyticBatch(Lambert::new(LambertParams { albedo: a }));
+    let brdf = Lambert::new(LambertParams { albedo: a });
     let pairs: Vec<EnergyPair> =
         (0..10).map(|i| EnergyPair { point: i, l: light(8.0 * i as f32) }).collect();
     for cfg in [mc(2000), fast()] {
@@ -40,7 +40,7 @@ fn lambert_gives_its_albedo_within_the_error_bar() {
 
 #[test]
 fn deterministic_for_a_seed() {
-    let brdf = AnalyticBatch(TorranceSparrow::new(TorranceSparrowParams::<f32>::default()));
+    let brdf = TorranceSparrow::new(TorranceSparrowParams::<f32>::default());
     let pairs: Vec<EnergyPair> =
         (0..5).map(|i| EnergyPair { point: i, l: light(15.0 * i as f32) }).collect();
     for cfg in [mc(500), fast()] {
@@ -56,7 +56,7 @@ fn deterministic_for_a_seed() {
 #[test]
 fn violation_summary() {
     // f = k / pi: E = k exactly. Points 0..3 have k = 0.5, 1.5, 2.5, and one channel only.
-    let brdf = FnBatch(|p: u32, _l: [f32; 3], _v: [f32; 3]| {
+    let brdf = FnSurface(|p: u32, _l: [f32; 3], _v: [f32; 3]| {
         [0.2, (0.5 + p as f32) / std::f32::consts::PI, 0.1]
     });
     let pairs: Vec<EnergyPair> = (0..3).map(|i| EnergyPair { point: i, l: light(30.0) }).collect();
@@ -94,7 +94,7 @@ fn sample_pairs_is_deterministic_and_distinct() {
 
 #[test]
 fn bad_configuration_is_an_error() {
-    let brdf = AnalyticBatch(Lambert::new(LambertParams::<f32>::default()));
+    let brdf = Lambert::new(LambertParams::<f32>::default());
     let pairs = [EnergyPair { point: 0, l: light(0.0) }];
     let cfg =
         EnergyConfig { estimator: Estimator::MonteCarlo { samples: 0 }, ..Default::default() };
@@ -169,7 +169,7 @@ fn estimators_agree_on_glossy_models() {
             diffuse: [0.6, 0.3, 0.1],
             f0: [0.9, 0.9, 0.9],
         });
-        let brdf = AnalyticBatch(ts);
+        let brdf = ts;
         let pairs: Vec<EnergyPair> =
             angles.iter().map(|t| EnergyPair { point: 0, l: light(*t) }).collect();
         let slow = energy_conservation(&brdf, &pairs, &mc(20_000)).unwrap();

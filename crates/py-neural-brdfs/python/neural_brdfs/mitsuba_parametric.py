@@ -41,6 +41,7 @@ import mitsuba as mi
 import numpy as np
 
 from . import reference_numpy as ref
+from .fmbrdf_weights import FMBRDF_WEIGHTS_ENV, default_fmbrdf_weights, read_fmbrdf_weights
 
 __all__ = ["SUPPORTED", "OUTPUTS", "mlp_specs", "params_of_outputs", "brdf", "forward",
            "LobeFitModel"]
@@ -249,58 +250,6 @@ FMBRDF_GLOBAL_GAIN = 10.0
 FMBRDF_ALPHA_RANGE, FMBRDF_BETA_RANGE = (0.001, 2.0 * np.pi), (0.5, 4.0)
 FMBRDF_NODES, FMBRDF_TAIL = 24, 40.0
 #: The environment variable naming ``fmbrdf_weights.bin`` (the plugin's ``fmbrdf_weights``).
-FMBRDF_WEIGHTS_ENV = "NEURAL_BRDF_FMBRDF_WEIGHTS"
-_FMBRDF_TENSORS = (
-    [(f"shadowing.fc{k}", s) for k, s in ((1, (300, 4)), (2, (100, 300)), (3, (50, 100)),
-                                         (4, (1, 50)))]
-    + [(f"body_reflection.fc_I{k}", s) for k, s in ((1, (200, 11)), (2, (100, 200)),
-                                                   (3, (100, 100)), (4, (1, 100)))])
-
-
-def default_fmbrdf_weights():
-    """``$NEURAL_BRDF_FMBRDF_WEIGHTS`` (a path), else the weights the package ships (the bytes
-    of ``brdf-analytic``'s ``assets/fmbrdf/fmbrdf_weights.bin``, from the native module)."""
-    import os
-    env = os.environ.get(FMBRDF_WEIGHTS_ENV)
-    if env:
-        return env
-    from . import _native
-    return bytes(_native.fmbrdf_weights_file())
-
-
-def read_fmbrdf_weights(path):
-    """The helper networks' tensors of ``fmbrdf_weights.bin`` (format: the crate's
-    ``assets/fmbrdf/NOTICE.md``), given as a path or as the file's bytes: ``{name: float32
-    array}``, checked names and shapes."""
-    import struct
-    if isinstance(path, (bytes, bytearray)):
-        data, path = bytes(path), "the package's FMBRDF weights"
-    else:
-        with open(path, "rb") as fh:
-            data = fh.read()
-    if data[:8] != b"FMBRDFW1":
-        raise ValueError(f"{path}: not an FMBRDF weights file (magic {data[:8]!r})")
-    try:
-        (count,), pos, out = struct.unpack_from("<I", data, 8), 12, {}
-        for _ in range(count):
-            (n,) = struct.unpack_from("<I", data, pos)
-            name = data[pos + 4:pos + 4 + n].decode()
-            pos += 4 + n
-            (ndim,) = struct.unpack_from("<I", data, pos)
-            dims = struct.unpack_from(f"<{ndim}I", data, pos + 4)
-            pos += 4 + 4 * ndim
-            size = int(np.prod(dims))
-            out[name] = np.frombuffer(data, "<f4", size, pos).reshape(dims).astype(np.float32)
-            pos += 4 * size
-    except (struct.error, ValueError, UnicodeDecodeError) as e:
-        raise ValueError(f"{path}: truncated or malformed FMBRDF weights file ({e})") from None
-    for name, shape in _FMBRDF_TENSORS:
-        w, b = out.get(name + ".weight"), out.get(name + ".bias")
-        if w is None or b is None or w.shape != shape or b.shape != shape[:1]:
-            raise ValueError(f"{path}: lacks {name}.weight {shape} / .bias {shape[:1]}")
-    return out
-
-
 def _f32(x):
     return np.float32(x)
 

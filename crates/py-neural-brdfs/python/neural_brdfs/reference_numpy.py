@@ -1,7 +1,7 @@
 """Reference numpy implementation of the neural BRDF models of ``brdf-neural``.
 
 Rebuilds a fitted model from an export folder (``model.safetensors`` or ``weights.safetensors``
-and ``model.json``, from ``experiments::export::portable``) and evaluates it with numpy alone:
+and ``model.json``, from ``experiments::portable``) and evaluates it with numpy alone:
 
 >>> m = load("runs/spot/export")
 >>> f = m.eval(triangle, barycentric, l, v)          # (n, 3) f_r, linear RGB, 1/sr

@@ -42,12 +42,13 @@ from __future__ import annotations
 import json
 import math
 import os
-import struct
 
 import numpy as np
 import torch
 from torch import nn
 import torch.nn.functional as F
+
+from .fmbrdf_weights import FMBRDF_WEIGHTS_ENV, default_fmbrdf_weights, read_fmbrdf_weights
 
 try:
     from . import reference_numpy as _ref
@@ -75,12 +76,6 @@ FMBRDF_GLOBAL_GAIN, FMBRDF_INIT = 10.0, (0.3, 2.0)
 FMBRDF_ALPHA_RANGE, FMBRDF_BETA_RANGE = (0.001, 2.0 * math.pi), (0.5, 4.0)
 FMBRDF_NODES, FMBRDF_TAIL = 24, 40.0
 #: The environment variable naming ``fmbrdf_weights.bin`` (as the Mitsuba plugin's).
-FMBRDF_WEIGHTS_ENV = "NEURAL_BRDF_FMBRDF_WEIGHTS"
-_FMBRDF_TENSORS = (
-    [(f"shadowing.fc{k}", s) for k, s in ((1, (300, 4)), (2, (100, 300)), (3, (50, 100)),
-                                         (4, (1, 50)))]
-    + [(f"body_reflection.fc_I{k}", s) for k, s in ((1, (200, 11)), (2, (100, 200)),
-                                                   (3, (100, 100)), (4, (1, 100)))])
 
 
 def mlp_specs(config):
@@ -300,53 +295,6 @@ def disney(p, g):
 
 
 # -------------------------------------------------------------------------------------- FMBRDF
-def default_fmbrdf_weights():
-    """``$NEURAL_BRDF_FMBRDF_WEIGHTS`` (a path), else the bytes of ``brdf-analytic``'s
-    ``assets/fmbrdf/fmbrdf_weights.bin`` from the native module (as the Mitsuba plugin)."""
-    env = os.environ.get(FMBRDF_WEIGHTS_ENV)
-    if env:
-        return env
-    try:
-        from . import _native
-    except ImportError:
-        raise FileNotFoundError(
-            f"FMBRDF's helper networks' weights: the native module is not importable here; "
-            f"set ${FMBRDF_WEIGHTS_ENV} or pass fmbrdf_weights (a path to "
-            f"crates/brdf-analytic/assets/fmbrdf/fmbrdf_weights.bin)") from None
-    return bytes(_native.fmbrdf_weights_file())
-
-
-def read_fmbrdf_weights(path):
-    """FMBRDF's helper-network tensors of ``fmbrdf_weights.bin`` (a path or its bytes; format:
-    ``assets/fmbrdf/NOTICE.md``: magic ``FMBRDFW1``, u32 count, then per tensor u32 name
-    length, name, u32 ndim, u32 dims, f32 LE data): ``{name: float32 array}``, checked."""
-    if isinstance(path, (bytes, bytearray)):
-        data, path = bytes(path), "the package's FMBRDF weights"
-    else:
-        with open(path, "rb") as fh:
-            data = fh.read()
-    if data[:8] != b"FMBRDFW1":
-        raise ValueError(f"{path}: not an FMBRDF weights file (magic {data[:8]!r})")
-    try:
-        (count,), pos, out = struct.unpack_from("<I", data, 8), 12, {}
-        for _ in range(count):
-            (n,) = struct.unpack_from("<I", data, pos)
-            name = data[pos + 4:pos + 4 + n].decode()
-            (ndim,) = struct.unpack_from("<I", data, pos + 4 + n)
-            dims = struct.unpack_from(f"<{ndim}I", data, pos + 8 + n)
-            pos += 8 + n + 4 * ndim
-            size = int(np.prod(dims))
-            out[name] = np.frombuffer(data, "<f4", size, pos).reshape(dims).astype(F32)
-            pos += 4 * size
-    except (struct.error, ValueError, UnicodeDecodeError) as e:
-        raise ValueError(f"{path}: truncated or malformed FMBRDF weights file ({e})") from None
-    for name, shape in _FMBRDF_TENSORS:
-        w, b = out.get(name + ".weight"), out.get(name + ".bias")
-        if w is None or b is None or w.shape != shape or b.shape != shape[:1]:
-            raise ValueError(f"{path}: lacks {name}.weight {shape} / .bias {shape[:1]}")
-    return out
-
-
 class FmbrdfNets(nn.Module):
     """FMBRDF's fixed helper networks as non-persistent buffers (not parameters, not in the
     ``state_dict``; gradients flow through them to alpha, beta, eta and kappa):

@@ -198,7 +198,7 @@ pub fn submit(
     std::fs::create_dir_all(&logs).map_err(|e| Error::io(&logs, e))?;
     std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
     let dir = std::path::absolute(&dir).map_err(|e| Error::io(&dir, e))?;
-    let backend = brdf_neural::device::Backend::parse(&sweep.backend)
+    let backend = brdf_neural::device::parse_backend(&sweep.backend)
         .map_err(|e| Error::config("backend", e.to_string()))?;
     let sbatch_options = options.sbatch_options();
     let name = format!("nbrdf-{}", sweep.profile);

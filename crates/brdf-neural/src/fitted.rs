@@ -1,10 +1,69 @@
-//! Evaluating a fitted model on CPU records: the BRDF and, for additive models, its parts; and
-//! the model as a [`metrics::BatchBrdf`] for the BRDF-space analyses (energy, reciprocity).
+//! A fitted model over surface points: its predictions on records, the inputs it keeps on the
+//! device, and the model as a [`brdf_analytic::SurfaceBrdf`], the one interface validation,
+//! evaluation, export, the metrics and the probes take.
+//!
+//! Records are (point, l, v) triples whose points index rows of spatial features
+//! ([`PointRows`]). On a CPU a pass gathers each record's row; on a GPU the rows of every
+//! point live on the device ([`device_table`]) and a pass selects them there, so that a pass
+//! uploads only indices and directions. Training keeps its records there too
+//! ([`device_records`]).
 
-use crate::data::TrainingData;
-use crate::{Error, Result};
-use brdf_neural::{BrdfBatch, BrdfModel, ModelConfig, Samples, SpatialTable, split_k};
-use burn::tensor::{Device, Tensor};
+use crate::{
+    BrdfBatch, BrdfModel, Error, ModelConfig, RecordTable, Result, Samples, SpatialTable,
+    batch_split,
+};
+use burn::tensor::{Device, Tensor, TensorData};
+
+/// Spatial rows of surface points, row-major `[points, dim]`, and the point of each record.
+#[derive(Clone, Copy, Debug)]
+pub struct PointRows<'a> {
+    /// The rows, `dim` floats a point.
+    pub spatial: &'a [f32],
+    /// Features a point (0: the model takes none).
+    pub dim: usize,
+    /// Each record's point: record `i` has row `point[i]`.
+    pub point: &'a [u32],
+}
+
+impl<'a> PointRows<'a> {
+    /// The spatial row of record `i`.
+    pub fn row(&self, i: usize) -> &'a [f32] {
+        let (p, k) = (self.point[i] as usize, self.dim);
+        &self.spatial[p * k..(p + 1) * k]
+    }
+
+    /// The spatial rows of `records`, row-major (the input of a batch).
+    pub fn rows(&self, records: std::ops::Range<usize>) -> Vec<f32> {
+        let mut out = Vec::with_capacity(records.len() * self.dim);
+        for i in records {
+            out.extend_from_slice(self.row(i));
+        }
+        out
+    }
+}
+
+/// Records to evaluate a model on: their points and local directions.
+#[derive(Clone, Copy, Debug)]
+pub struct Records<'a> {
+    /// The records' points and the points' spatial rows.
+    pub points: PointRows<'a>,
+    /// Directions to the light, local frame.
+    pub l: &'a [[f32; 3]],
+    /// Directions to the viewer, local frame.
+    pub v: &'a [[f32; 3]],
+}
+
+impl Records<'_> {
+    /// The number of records.
+    pub fn len(&self) -> usize {
+        self.l.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.l.is_empty()
+    }
+}
 
 /// Rows per forward pass.
 pub const CHUNK: usize = 1 << 15;
@@ -49,7 +108,7 @@ fn rows(t: Tensor<2>, what: &str) -> Result<Vec<[f32; 3]>> {
     let v: Vec<f32> = t
         .into_data()
         .try_to_vec::<f32>()
-        .map_err(|e| Error::config("model", format!("{what} output is not f32: {e:?}")))?;
+        .map_err(|e| Error::Readback(format!("{what} output is not f32: {e:?}")))?;
     Ok(v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
 }
 
@@ -61,11 +120,11 @@ pub fn forward_rows(
     device: &Device,
     parts: bool,
 ) -> Result<Prediction> {
-    let gpu = !brdf_neural::device::is_cpu_device(device);
+    let gpu = !crate::device::is_cpu_device(device);
     let rows = pass_rows(samples.l.len(), gpu);
-    // On a GPU, the training loop's parts of 512 rows (`split_k::gpu_parts`): every pass of
+    // On a GPU, the training loop's parts of 512 rows (`batch_split::gpu_parts`): every pass of
     // an evaluation then meets the matrix-product shapes that training tuned.
-    let _split = gpu.then(|| split_k::scope(split_k::gpu_parts(rows)));
+    let _split = gpu.then(|| batch_split::scope(batch_split::gpu_parts(rows)));
     forward_padded(model, config, Spatial::Rows, samples, device, parts, rows)
 }
 
@@ -83,9 +142,9 @@ pub fn forward_points(
     device: &Device,
     parts: bool,
 ) -> Result<Prediction> {
-    let gpu = !brdf_neural::device::is_cpu_device(device);
+    let gpu = !crate::device::is_cpu_device(device);
     let rows = pass_rows(l.len(), gpu);
-    let _split = gpu.then(|| split_k::scope(split_k::gpu_parts(rows)));
+    let _split = gpu.then(|| batch_split::scope(batch_split::gpu_parts(rows)));
     let samples = Samples { spatial: &[], l, v };
     forward_padded(model, config, Spatial::Table(table, points), &samples, device, parts, rows)
 }
@@ -154,42 +213,42 @@ fn forward_padded(
     Ok(p)
 }
 
-/// Evaluates `model` on every record of `data` (with the additive parts when `parts`); on a
-/// GPU the records' spatial rows are selected on the device ([`predict_on`] with a table of
-/// `data`'s points, [`crate::trainer::device_table`]).
+/// Evaluates `model` on every record (with the additive parts when `parts`); on a GPU the
+/// records' spatial rows are selected on the device ([`predict_on`] with a table of their
+/// points, [`device_table`]).
 pub fn predict(
     model: &BrdfModel,
     config: &ModelConfig,
-    data: &TrainingData,
+    records: Records,
     device: &Device,
     parts: bool,
 ) -> Result<Prediction> {
-    let gpu = !brdf_neural::device::is_cpu_device(device);
-    let table = crate::trainer::device_table(config, data, gpu, device)?;
-    predict_on(model, config, data, table.as_ref(), device, parts)
+    let gpu = !crate::device::is_cpu_device(device);
+    let table = device_table(config, records.points, gpu, device)?;
+    predict_on(model, config, records, table.as_ref(), device, parts)
 }
 
-/// [`predict`] with the spatial rows of `data`'s points on the device already (`table`, on
+/// [`predict`] with the spatial rows of the records' points on the device already (`table`, on
 /// `device`), or gathered on the CPU chunk by chunk (`None`).
 pub fn predict_on(
     model: &BrdfModel,
     config: &ModelConfig,
-    data: &TrainingData,
+    records: Records,
     table: Option<&SpatialTable>,
     device: &Device,
     parts: bool,
 ) -> Result<Prediction> {
     let mut all = Prediction::default();
-    for start in (0..data.len()).step_by(CHUNK) {
-        let end = (start + CHUNK).min(data.len());
-        let (l, v) = (&data.l[start..end], &data.v[start..end]);
+    for start in (0..records.len()).step_by(CHUNK) {
+        let end = (start + CHUNK).min(records.len());
+        let (l, v) = (&records.l[start..end], &records.v[start..end]);
         let p = match table {
             Some(table) => {
-                let points = &data.point[start..end];
+                let points = &records.points.point[start..end];
                 forward_points(model, config, table, points, l, v, device, parts)?
             }
             None => {
-                let samples = Samples { spatial: &data.spatial_rows(start..end), l, v };
+                let samples = Samples { spatial: &records.points.rows(start..end), l, v };
                 forward_rows(model, config, &samples, device, parts)?
             }
         };
@@ -207,46 +266,119 @@ pub fn predict_on(
     Ok(all)
 }
 
-/// Rows per pass of [`ModelBrdf`] on a GPU: eight of [`CHUNK`]. The energy analysis then
+/// Largest spatial table [`device_table`] puts on a GPU, in bytes (a 512 px scene of the
+/// `full` profile needs at most 0.42 GB: 652,749 training pixels x 160 floats for Spot).
+pub const DEVICE_TABLE_MAX_BYTES: usize = 2 << 30;
+
+/// The spatial rows of every point on `device` when `on_device` (the default on a GPU): each
+/// pass then selects its rows there, instead of 640 bytes a sample copied on the CPU and
+/// uploaded with every pass. `None` otherwise (on the CPU the gather is the selection), without
+/// spatial features, or past [`DEVICE_TABLE_MAX_BYTES`]. Not handled yet: a GPU whose largest
+/// storage buffer is smaller than the table (Vulkan's `maxStorageBufferRange`, 128 MiB on some
+/// integrated GPUs; 4 GiB on NVIDIA's) fails to allocate it.
+pub fn device_table(
+    config: &ModelConfig,
+    points: PointRows,
+    on_device: bool,
+    device: &Device,
+) -> Result<Option<SpatialTable>> {
+    let bytes = std::mem::size_of_val(points.spatial);
+    if !on_device || points.dim == 0 || bytes > DEVICE_TABLE_MAX_BYTES {
+        return Ok(None);
+    }
+    Ok(Some(SpatialTable::new(config, points.spatial, device)?))
+}
+
+/// Training records on the device: their direction inputs ([`RecordTable`]), weights
+/// (`E cos theta_l`) and targets (the observations' sRGB values), `[records, 3]` each.
+pub struct DeviceRecords {
+    /// The direction inputs and points.
+    pub table: RecordTable,
+    /// Each record's weight.
+    pub weight: Tensor<2>,
+    /// Each record's target.
+    pub target: Tensor<2>,
+}
+
+/// Largest record table [`device_records`] puts on a GPU, in bytes, weights and targets
+/// included.
+pub const DEVICE_RECORDS_MAX_BYTES: usize = 4 << 30;
+
+/// Every record on `device`, with its weight and target (one RGB triple a record each), when
+/// `on_device` (the trainer's default on a GPU) and the model's spatial rows are there too
+/// (`spatial`, from [`device_table`]): each batch then uploads only its record indices. `None`
+/// otherwise, or past [`DEVICE_RECORDS_MAX_BYTES`].
+pub fn device_records(
+    config: &ModelConfig,
+    records: Records,
+    weight: &[[f32; 3]],
+    target: &[[f32; 3]],
+    spatial: Option<&SpatialTable>,
+    on_device: bool,
+    device: &Device,
+) -> Result<Option<DeviceRecords>> {
+    let n = records.len();
+    if weight.len() != n || target.len() != n {
+        return Err(Error::BatchShape(format!(
+            "{n} records with {} weights and {} targets",
+            weight.len(),
+            target.len()
+        )));
+    }
+    let bytes = RecordTable::bytes(config, n) + n * 6 * 4;
+    if !on_device
+        || (config.spatial_dim > 0 && spatial.is_none())
+        || bytes > DEVICE_RECORDS_MAX_BYTES
+    {
+        return Ok(None);
+    }
+    let table = RecordTable::new(config, records.l, records.v, records.points.point, device)?;
+    let rows = |x: &[[f32; 3]]| {
+        Tensor::<2>::from_data(TensorData::new(x.as_flattened().to_vec(), [n, 3]), device)
+    };
+    Ok(Some(DeviceRecords { table, weight: rows(weight), target: rows(target) }))
+}
+
+/// Rows per pass of [`NeuralSurface`] on a GPU: eight of [`CHUNK`]. The energy analysis then
 /// evaluates 13 of the paper's pairs (20,000 samples each) a pass, and the host samples their
 /// directions on every core while the device runs (a pair a pass, at [`CHUNK`], left one
 /// core sampling and a readback every 20,000 evaluations).
 pub const GPU_BATCH: usize = 8 * CHUNK;
 
-/// A fitted model as a [`metrics::BatchBrdf`]: point `i` is record `i` of `data` (its spatial
-/// features); directions are the analyses' local-frame ones. Evaluation errors (which cannot
+/// A fitted model as a [`brdf_analytic::SurfaceBrdf`]: point `i` is record `i` of `points` (its
+/// spatial row); directions are the callers' local-frame ones. Evaluation errors (which cannot
 /// happen for a model that loaded) surface as NaN, which the analyses reject.
 ///
-/// On a GPU the spatial rows of `data`'s points live on the device
-/// ([`crate::trainer::device_table`]), and each pass selects its rows there: the analyses
+/// On a GPU the spatial rows of the points live on the device ([`device_table`]), and each
+/// pass selects its rows there: the analyses
 /// evaluate a point thousands of times (the paper's energy protocol 20,000 times a pair), and
 /// copying its row (160 floats at 512 px) for every evaluation would make the host, not the
 /// device, set the pace.
-pub struct ModelBrdf<'a> {
+pub struct NeuralSurface<'a> {
     model: &'a BrdfModel,
     config: &'a ModelConfig,
-    data: &'a TrainingData,
+    points: PointRows<'a>,
     device: &'a Device,
     gpu: bool,
     table: Option<SpatialTable>,
 }
 
-impl<'a> ModelBrdf<'a> {
-    /// The model on the records of `data`, their spatial rows uploaded on a GPU.
+impl<'a> NeuralSurface<'a> {
+    /// The model on the records of `points`, their spatial rows uploaded on a GPU.
     pub fn new(
         model: &'a BrdfModel,
         config: &'a ModelConfig,
-        data: &'a TrainingData,
+        points: PointRows<'a>,
         device: &'a Device,
     ) -> Result<Self> {
-        let gpu = !brdf_neural::device::is_cpu_device(device);
-        let table = crate::trainer::device_table(config, data, gpu, device)?;
-        Ok(Self { model, config, data, device, gpu, table })
+        let gpu = !crate::device::is_cpu_device(device);
+        let table = device_table(config, points, gpu, device)?;
+        Ok(Self { model, config, points, device, gpu, table })
     }
 
-    /// The records whose spatial features the points index.
-    pub fn data(&self) -> &'a TrainingData {
-        self.data
+    /// The records whose spatial rows the points index.
+    pub fn points(&self) -> PointRows<'a> {
+        self.points
     }
 
     /// Whether the spatial rows are selected on the device.
@@ -255,18 +387,18 @@ impl<'a> ModelBrdf<'a> {
     }
 }
 
-impl metrics::BatchBrdf for ModelBrdf<'_> {
-    fn eval_batch(&self, points: &[u32], l: &[[f32; 3]], v: &[[f32; 3]], out: &mut [[f32; 3]]) {
+impl brdf_analytic::SurfaceBrdf for NeuralSurface<'_> {
+    fn eval_points(&self, points: &[u32], l: &[[f32; 3]], v: &[[f32; 3]], out: &mut [[f32; 3]]) {
         let p = match &self.table {
             Some(table) => {
-                let rows: Vec<u32> = points.iter().map(|&p| self.data.point[p as usize]).collect();
+                let rows: Vec<u32> =
+                    points.iter().map(|&p| self.points.point[p as usize]).collect();
                 forward_points(self.model, self.config, table, &rows, l, v, self.device, false)
             }
             None => {
-                let k = self.data.spatial_dim;
-                let mut spatial = Vec::with_capacity(points.len() * k);
+                let mut spatial = Vec::with_capacity(points.len() * self.points.dim);
                 for &p in points {
-                    spatial.extend_from_slice(self.data.spatial_row(p as usize));
+                    spatial.extend_from_slice(self.points.row(p as usize));
                 }
                 let samples = Samples { spatial: &spatial, l, v };
                 forward_rows(self.model, self.config, &samples, self.device, false)
@@ -291,7 +423,7 @@ impl metrics::BatchBrdf for ModelBrdf<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use brdf_neural::ModelKind;
+    use crate::ModelKind;
 
     #[test]
     fn gpu_passes_round_up_to_few_shapes_and_cpu_passes_do_not() {
@@ -320,7 +452,7 @@ mod tests {
 
     #[test]
     fn padded_passes_give_the_unpadded_values() {
-        let device = brdf_neural::device::cpu();
+        let device = crate::device::cpu();
         for kind in [ModelKind::SingleMlp, ModelKind::AdditiveSharedEnhanced, ModelKind::Disney] {
             let config = ModelConfig { spatial_dim: 4, ..ModelConfig::new(kind) };
             let model = BrdfModel::init(&config, &device).unwrap();
@@ -346,16 +478,16 @@ mod tests {
         }
     }
 
-    /// On a GPU (`cargo test -p experiments --features wgpu`, lavapipe will do), a pass padded
+    /// On a GPU (`cargo test -p brdf-neural --features wgpu`, lavapipe will do), a pass padded
     /// to a power of two and split into parts of 512 rows gives the CPU's values.
     #[cfg(feature = "wgpu")]
     #[test]
     fn gpu_passes_padded_and_split_give_the_cpus_values() {
-        use brdf_neural::device::Backend;
+        use crate::device::{Backend, BackendDevice};
         use burn::module::Module;
-        let cpu = brdf_neural::device::cpu();
+        let cpu = crate::device::cpu();
         let gpu = Backend::Wgpu.device().unwrap();
-        assert!(!brdf_neural::device::is_cpu_device(&gpu));
+        assert!(!crate::device::is_cpu_device(&gpu));
         for kind in [ModelKind::SingleMlp, ModelKind::Disney] {
             let config = ModelConfig { spatial_dim: 4, ..ModelConfig::new(kind) };
             let model = BrdfModel::init(&config, &cpu).unwrap();
@@ -373,48 +505,39 @@ mod tests {
         }
     }
 
-    /// Records whose points repeat: 7 points, 40 records.
-    fn records(config: &ModelConfig) -> TrainingData {
+    /// Records whose points repeat: 7 points, 40 records (spatial rows, points, l, v).
+    #[allow(clippy::type_complexity)]
+    fn records() -> (Vec<f32>, Vec<u32>, Vec<[f32; 3]>, Vec<[f32; 3]>) {
         let (spatial, _, _) = inputs(7);
         let (_, l, v) = inputs(40);
-        TrainingData {
-            spatial: std::sync::Arc::new(spatial),
-            spatial_dim: config.spatial_dim,
-            point: (0..40).map(|i| (i * 3 % 7) as u32).collect(),
-            l,
-            v,
-            ..Default::default()
-        }
+        (spatial, (0..40).map(|i| (i * 3 % 7) as u32).collect(), l, v)
     }
 
-    /// Evaluates records 39, 0, 5, ... of `data` through [`metrics::BatchBrdf`].
-    fn as_batch_brdf(brdf: &ModelBrdf, data: &TrainingData) -> Vec<[f32; 3]> {
-        use metrics::BatchBrdf;
+    /// Evaluates records 39, 0, 5, ... through [`brdf_analytic::SurfaceBrdf`].
+    fn as_surface(brdf: &NeuralSurface, l: &[[f32; 3]], v: &[[f32; 3]]) -> Vec<[f32; 3]> {
+        use brdf_analytic::SurfaceBrdf;
         let records: Vec<u32> = (0..40).map(|i| (39 + 5 * i) % 40).collect();
-        let l: Vec<[f32; 3]> = records.iter().map(|&r| data.l[r as usize]).collect();
-        let v: Vec<[f32; 3]> = records.iter().map(|&r| data.v[r as usize]).collect();
+        let l: Vec<[f32; 3]> = records.iter().map(|&r| l[r as usize]).collect();
+        let v: Vec<[f32; 3]> = records.iter().map(|&r| v[r as usize]).collect();
         let mut out = vec![[0.0; 3]; records.len()];
-        brdf.eval_batch(&records, &l, &v, &mut out);
+        brdf.eval_points(&records, &l, &v, &mut out);
         out
     }
 
     #[test]
-    fn the_model_as_a_batch_brdf_reads_each_records_point_on_the_cpu() {
-        let device = brdf_neural::device::cpu();
+    fn the_model_as_a_surface_brdf_reads_each_records_point_on_the_cpu() {
+        let device = crate::device::cpu();
         let config = ModelConfig { spatial_dim: 4, ..ModelConfig::new(ModelKind::SingleMlp) };
         let model = BrdfModel::init(&config, &device).unwrap();
-        let data = records(&config);
-        let brdf = ModelBrdf::new(&model, &config, &data, &device).unwrap();
+        let (spatial, point, l, v) = records();
+        let points = PointRows { spatial: &spatial, dim: 4, point: &point };
+        let brdf = NeuralSurface::new(&model, &config, points, &device).unwrap();
         assert!(!brdf.rows_on_device());
-        assert_eq!(metrics::BatchBrdf::preferred_batch(&brdf), CHUNK);
-        let got = as_batch_brdf(&brdf, &data);
+        assert_eq!(brdf_analytic::SurfaceBrdf::preferred_batch(&brdf), CHUNK);
+        let got = as_surface(&brdf, &l, &v);
         for (i, g) in got.iter().enumerate() {
             let r = (39 + 5 * i) % 40;
-            let samples = Samples {
-                spatial: data.spatial_row(r),
-                l: &data.l[r..r + 1],
-                v: &data.v[r..r + 1],
-            };
+            let samples = Samples { spatial: points.row(r), l: &l[r..r + 1], v: &v[r..r + 1] };
             let want = forward_rows(&model, &config, &samples, &device, false).unwrap().f[0];
             assert_eq!(*g, want, "record {r}");
         }
@@ -423,21 +546,23 @@ mod tests {
     /// On a GPU the records' rows are selected from a table on the device: the CPU's values.
     #[cfg(feature = "wgpu")]
     #[test]
-    fn the_model_as_a_batch_brdf_selects_rows_on_the_gpu() {
-        use brdf_neural::device::Backend;
+    fn the_model_as_a_surface_brdf_selects_rows_on_the_gpu() {
+        use crate::device::{Backend, BackendDevice};
         use burn::module::Module;
-        let cpu = brdf_neural::device::cpu();
+        let cpu = crate::device::cpu();
         let gpu = Backend::Wgpu.device().unwrap();
         for kind in [ModelKind::SingleMlp, ModelKind::Disney] {
             let config = ModelConfig { spatial_dim: 4, ..ModelConfig::new(kind) };
             let model = BrdfModel::init(&config, &cpu).unwrap();
             let on_gpu = model.clone().fork(&gpu);
-            let data = records(&config);
-            let want = as_batch_brdf(&ModelBrdf::new(&model, &config, &data, &cpu).unwrap(), &data);
-            let brdf = ModelBrdf::new(&on_gpu, &config, &data, &gpu).unwrap();
+            let (spatial, point, l, v) = records();
+            let points = PointRows { spatial: &spatial, dim: 4, point: &point };
+            let want =
+                as_surface(&NeuralSurface::new(&model, &config, points, &cpu).unwrap(), &l, &v);
+            let brdf = NeuralSurface::new(&on_gpu, &config, points, &gpu).unwrap();
             assert!(brdf.rows_on_device());
-            assert_eq!(metrics::BatchBrdf::preferred_batch(&brdf), GPU_BATCH);
-            let got = as_batch_brdf(&brdf, &data);
+            assert_eq!(brdf_analytic::SurfaceBrdf::preferred_batch(&brdf), GPU_BATCH);
+            let got = as_surface(&brdf, &l, &v);
             for (x, y) in want.iter().flatten().zip(got.iter().flatten()) {
                 assert!((x - y).abs() <= 1e-4 * x.abs().max(1e-3), "{kind:?}: {x} against {y}");
             }

@@ -24,7 +24,7 @@
 //! layers, skips, angle features and encodings, heads), `spatial` (`kind`, `dim`) and
 //! `conventions` (frames and units, in words).
 
-use crate::export::vertex_features;
+use crate::data::vertex_features;
 use crate::{Error, Result};
 use burn::tensor::DType;
 use run_format::config::RunConfig;

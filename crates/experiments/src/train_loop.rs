@@ -7,12 +7,14 @@
 //! run repeats an uninterrupted one exactly.
 
 use crate::checkpoint::{self, CheckpointState};
-use crate::data::TrainingData;
+use crate::data::RecordSet;
 use crate::diagnose::{all_finite, diagnose, worst_input};
 use crate::loss::{LossWeights, loss, srgb_oetf};
 use crate::loss_window::{FreshLeaves, LossWindow, StepLoss, WindowStart};
 use crate::{Error, Result};
-use brdf_neural::{BrdfBatch, BrdfModel, Reciprocity, RecordTable, Samples, SpatialTable};
+use brdf_neural::fitted::{DeviceRecords, predict_on};
+use brdf_neural::precision::PrecisionScope;
+use brdf_neural::{BrdfBatch, BrdfModel, Reciprocity, Samples, SpatialTable};
 use burn::module::Module;
 use burn::optim::{GradientsParams, ModuleOptimizer};
 use burn::tensor::{Device, Tensor, TensorData};
@@ -45,13 +47,13 @@ pub(crate) struct Loop<'a> {
     /// The run directory.
     pub run: &'a RunDir,
     /// Training records.
-    pub data: &'a TrainingData,
+    pub data: &'a RecordSet,
     /// Validation records (empty without a validation split).
-    pub val: &'a TrainingData,
+    pub val: &'a RecordSet,
     /// The training (autodiff) device.
     pub device: Device,
     /// On a GPU: the spatial rows of every point, on the device, where each batch selects its
-    /// rows ([`device_table`]); `None`: batches gather them on the CPU.
+    /// rows ([`brdf_neural::fitted::device_table`]); `None`: batches gather them on the CPU.
     pub spatial: Option<SpatialTable>,
     /// On a GPU: the same rows on the inference device, where validation selects its records'
     /// rows (validation and training records share their points).
@@ -59,7 +61,7 @@ pub(crate) struct Loop<'a> {
     /// The progress bar (hidden when not shown).
     pub bar: ProgressBar,
     /// On a GPU: every record's direction inputs, weights and targets on the device, where each
-    /// batch selects its rows ([`device_records`]); `None`: batches gather them on the CPU.
+    /// batch selects its rows ([`brdf_neural::fitted::device_records`]); `None`: batches gather them on the CPU.
     pub records: Option<DeviceRecords>,
     /// Steps between host reads of the training loss ([`crate::loss_window`]): 1 on the CPU,
     /// [`GPU_LOSS_READS`] on a GPU.
@@ -424,87 +426,24 @@ impl Loop<'_> {
     }
 }
 
-/// Largest spatial table [`device_table`] puts on a GPU, in bytes (a 512 px scene of the
-/// `full` profile needs at most 0.42 GB: 652,749 training pixels x 160 floats for Spot).
-pub const DEVICE_TABLE_MAX_BYTES: usize = 2 << 30;
-
-/// The training records on the device: their direction inputs ([`RecordTable`]), weights
-/// (`E cos theta_l`) and targets (the observations' sRGB values), `[records, 3]` each.
-pub struct DeviceRecords {
-    /// The direction inputs and points.
-    pub table: RecordTable,
-    /// Each record's weight.
-    pub weight: Tensor<2>,
-    /// Each record's target.
-    pub target: Tensor<2>,
-}
-
-/// Largest record table [`device_records`] puts on a GPU, in bytes, weights and targets
-/// included.
-pub const DEVICE_RECORDS_MAX_BYTES: usize = 4 << 30;
-
-/// Every record of `data` on `device` when `on_device` (the trainer's default on a GPU) and
-/// the model's spatial rows are there too (`spatial`, from [`device_table`]): each batch then
-/// uploads only its record indices. `None` otherwise, or past [`DEVICE_RECORDS_MAX_BYTES`].
-pub fn device_records(
-    model: &brdf_neural::ModelConfig,
-    data: &TrainingData,
-    spatial: Option<&SpatialTable>,
-    on_device: bool,
-    device: &Device,
-) -> Result<Option<DeviceRecords>> {
-    let n = data.len();
-    let bytes = RecordTable::bytes(model, n) + n * 6 * 4;
-    if !on_device
-        || (model.spatial_dim > 0 && spatial.is_none())
-        || bytes > DEVICE_RECORDS_MAX_BYTES
-    {
-        return Ok(None);
-    }
-    let table = RecordTable::new(model, &data.l, &data.v, &data.point, device)?;
-    let weight = tensor(data.weight.as_flattened().to_vec(), n, device);
-    let target = tensor(data.observed_gamma.as_flattened().to_vec(), n, device);
-    Ok(Some(DeviceRecords { table, weight, target }))
-}
-
-/// The spatial rows of every point of `data` on `device` when `on_device` (the trainer's
-/// default on a GPU): each batch then selects its rows there, instead of 640 bytes a sample
-/// copied on the CPU and uploaded with every step. `None` otherwise (on the CPU the gather is
-/// the selection), without spatial features, or past [`DEVICE_TABLE_MAX_BYTES`]. Not handled
-/// yet: a GPU whose largest storage buffer is smaller than the table (Vulkan's
-/// `maxStorageBufferRange`, 128 MiB on some integrated GPUs; 4 GiB on NVIDIA's) fails to
-/// allocate it; the default run's 128 px Spot scene needs at most 26 MB (40,815 training pixels).
-pub fn device_table(
-    model: &brdf_neural::ModelConfig,
-    data: &TrainingData,
-    on_device: bool,
-    device: &Device,
-) -> Result<Option<SpatialTable>> {
-    let bytes = std::mem::size_of_val(data.spatial.as_slice());
-    if !on_device || data.spatial_dim == 0 || bytes > DEVICE_TABLE_MAX_BYTES {
-        return Ok(None);
-    }
-    Ok(Some(SpatialTable::new(model, &data.spatial, device)?))
-}
-
 /// The gamma-MSE of `model` on the records `val` (no regularisers), computed in inference
 /// mode on `device` (the inference device of the training backend), the spatial rows of
 /// `val`'s points selected from `table` (on `device`) where there is one.
 pub fn validation_loss(
     model: &BrdfModel,
     config: &RunConfig,
-    val: &TrainingData,
+    val: &RecordSet,
     table: Option<&SpatialTable>,
     device: &Device,
 ) -> Result<f64> {
     let model = model.valid();
-    let pred = crate::eval::predict_on(&model, &config.model, val, table, device, false)?;
+    let pred = predict_on(&model, &config.model, val.records(), table, device, false)?;
     Ok(gamma_mse(val, &pred.f))
 }
 
 /// The gamma-MSE of the BRDF values `f` (one per record) on the records, renders clipped like
 /// the observations: the training loss without regularisers.
-pub fn gamma_mse(records: &TrainingData, f: &[[f32; 3]]) -> f64 {
+pub fn gamma_mse(records: &RecordSet, f: &[[f32; 3]]) -> f64 {
     let mut sum = 0.0_f64;
     let clip = records.clip.unwrap_or(f32::INFINITY);
     for ((f, w), g) in f.iter().zip(&records.weight).zip(&records.observed_gamma) {

@@ -1,10 +1,11 @@
 //! A finished run opened for analysis: its configuration, fitted model and scene, shared by
 //! `eval`, `energy` and `export-merl`.
 
-use crate::data::{TrainingData, spatial_features};
+use crate::data::{RecordSet, spatial_features};
 use crate::{Error, Result};
 use brdf_neural::BrdfModel;
 use brdf_neural::device::Backend;
+use brdf_neural::device::BackendDevice;
 use burn::tensor::Device;
 use run_format::config::RunConfig;
 use run_format::run_dir::RunDir;
@@ -42,7 +43,7 @@ impl FittedRun {
     /// Opens `run` on the default CPU backend; `scene` overrides the configured scene
     /// directory, `cache` the cache.
     pub fn open(run: &Path, scene: Option<&Path>, cache: Option<&Path>) -> Result<Self> {
-        Self::open_on(run, scene, cache, Backend::default())
+        Self::open_on(run, scene, cache, brdf_neural::device::default_backend())
     }
 
     /// [`FittedRun::open`] with the model on `backend`'s device.
@@ -77,11 +78,11 @@ impl FittedRun {
     }
 
     /// The lit test samples and their training records (features, local directions).
-    pub fn test_records(&self) -> Result<(SampleSet, TrainingData)> {
+    pub fn test_records(&self) -> Result<(SampleSet, RecordSet)> {
         let samples = self.dataset.samples(Split::Test)?;
         let spatial =
             spatial_features(&self.dataset, &samples, &self.config.features, &self.cache)?;
-        let data = TrainingData::new(&samples, &spatial);
+        let data = RecordSet::new(&samples, &spatial);
         Ok((samples, data))
     }
 }
