@@ -21,13 +21,13 @@ use crate::data::{RecordSet, spatial_features, split_validation, validation_pair
 use crate::fitted::FittedRun;
 use crate::train_loop::{GPU_LOSS_READS, Loop, LoopEnd, gamma_mse, save_weights};
 use crate::{Error, Result};
-use brdf_neural::device::BackendDevice;
-use brdf_neural::fitted::{device_records, device_table};
+use brdf_neural::device::{Backend, BackendDevice};
+use brdf_neural::fitted::{DeviceRecords, device_records, device_table};
 use brdf_neural::precision::MatmulPrecision;
 use brdf_neural::precision::PrecisionScope;
-use brdf_neural::{BrdfModel, batch_split};
+use brdf_neural::{BrdfModel, SpatialTable, batch_split};
 use burn::module::Module;
-use burn::optim::AdamConfig;
+use burn::optim::{AdamConfig, ModuleOptimizer};
 use burn::tensor::Device;
 use indicatif::ProgressBar;
 use run_format::config::RunConfig;
@@ -216,21 +216,8 @@ pub fn fit_and_keep(
 ) -> Result<(FitOutcome, Option<Trained>)> {
     let started = std::time::Instant::now();
     config.validate()?;
-    // One process at a time in a run directory; taking the lock removes the temporaries of a
-    // process killed in it.
-    let lock = stdx::lock::DirLock::acquire(run, "training")?;
-    if lock.removed_temporaries > 0 {
-        eprintln!(
-            "{}: removed {} temporary file(s) of an interrupted write",
-            run.display(),
-            lock.removed_temporaries
-        );
-    }
+    let _lock = lock_run_dir(run)?;
     let dir = RunDir::new(run);
-    // A kill between a checkpoint's write and the removal of the older ones leaves them.
-    if let Some((step, _)) = checkpoint::list(&dir)?.pop() {
-        checkpoint::remove_all_but(&dir, step)?;
-    }
     if let Some(metrics) = prepare_run_dir(config, &dir, options.config_from_run_dir)? {
         return Ok((FitOutcome::AlreadyFinished(metrics), None));
     }
@@ -239,36 +226,16 @@ pub fn fit_and_keep(
     let t = &config.train;
 
     let device = options.backend.training_device()?;
-    let initial_brdf = (t.output_init == OutputInit::Data).then(|| data.mean_brdf());
-    let mut model = BrdfModel::init_seeded(&config.model, &device, config.seed, initial_brdf)?;
-    let mut optim = AdamConfig::new().with_epsilon(t.adam_epsilon as f32).init();
-    let mut state = CheckpointState::default();
-    let last_checkpoint = checkpoint::latest(&dir)?;
-    if let Some(dir) = &last_checkpoint {
-        (model, optim, state) = checkpoint::load(dir, model, optim)?;
-    }
+    let (model, mut optim, state, last_checkpoint) = start(config, &dir, &data, &device)?;
     let resumed_from = state.step;
     if resumed_from > 0 {
         eprintln!("{}: resuming from the checkpoint at step {resumed_from}", run.display());
     }
     let bar = progress_bar(options.progress, t.iterations, state.step);
     let on_device = options.inputs_on_device.unwrap_or(options.backend.is_gpu());
-    let spatial = device_table(&config.model, data.points(), on_device, &device)?;
-    let has_val = !val.is_empty();
-    let val_spatial =
-        device_table(&config.model, val.points(), on_device && has_val, &device.clone().inner())?;
+    let (spatial, val_spatial, records) = device_inputs(config, (&data, &val), on_device, &device)?;
     let gpu_reads = if options.backend.is_gpu() { GPU_LOSS_READS } else { 1 };
     let loss_reads = options.loss_reads.or(loss_reads_from_env()?).unwrap_or(gpu_reads).max(1);
-    let (weight, target) = (&data.weight, &data.observed_gamma);
-    let records = device_records(
-        &config.model,
-        data.records(),
-        weight,
-        target,
-        spatial.as_ref(),
-        on_device,
-        &device,
-    )?;
     let lp = Loop {
         config,
         run: &dir,
@@ -285,23 +252,7 @@ pub fn fit_and_keep(
     };
     // The matrix-product precision of this thread's training steps; evaluation keeps f32.
     let precision = t.matmul_precision.scope(options.backend)?;
-    let cpu_bf16 = t.matmul_precision == MatmulPrecision::Bf16 && !options.backend.is_gpu();
-    if cpu_bf16 && !MatmulPrecision::bf16_native() {
-        eprintln!(
-            "{}: warning: matmul_precision = \"bf16\" on a CPU without AVX512-BF16: the products \
-             are emulated, about 2x slower a step than f32 (measured on an Intel Xeon \
-             without it); f32 is the faster choice here",
-            run.display()
-        );
-    } else if cpu_bf16 && MatmulPrecision::cpu_has_amx_bf16() && !MatmulPrecision::bf16_on_amx() {
-        eprintln!(
-            "{}: warning: matmul_precision = \"bf16\" on an Intel CPU with AMX, but the AMX \
-             kernel is off (CPU_KERNELS_AMX=0, or Linux refused the tile registers): the products \
-             run on AVX512-BF16, measured 1.3x slower a step than f32 on such a Xeon \
-             (benches/README.md); f32 is likely the faster choice here",
-            run.display()
-        );
-    }
+    warn_of_slow_bf16(run, t.matmul_precision, options.backend);
     // On a GPU, the weight gradients' sum over the batch is split into parts (split-K): the
     // GPU's matrix-product kernels do not split it themselves. The CPU keeps the plain product.
     let parts = if options.backend.is_gpu() { batch_split::gpu_parts(t.batch_size) } else { 1 };
@@ -333,22 +284,125 @@ pub fn fit_and_keep(
     } else {
         format!("step budget reached ({} steps)", state.step)
     });
-    // The curve of the last checkpoint, again: a kill between that checkpoint and its curve
-    // leaves the previous one's curve, and a run resumed from its last checkpoint trains no
-    // further step that would write it (the kill torture found such a run).
-    write_curve(&dir.curve(), &state.curve)?;
-    save_weights(&model, &dir.weights())?;
-    // The same weights for other tools (safetensors + JSON), before metrics.json marks the run
-    // finished, so a kill in between redoes both.
-    crate::portable::write(&dir, &dir.weights(), config, &scene, &cache)?;
     let mut metrics = run_metrics(config, &state, &data, val.len());
     metrics.backend = Some(options.backend);
     metrics.startup_seconds = lp.startup_seconds.get();
     metrics.val_loss_floor = val_floor;
-    metrics.write(&dir.metrics())?;
+    write_finished_run(&dir, config, (&model, &state), &metrics, (&scene, &cache))?;
     let device = lp.device.inner();
     let trained = Trained { model: model.valid(), device, scene };
     Ok((FitOutcome::Finished { metrics, resumed_from }, Some(trained)))
+}
+
+/// The model, optimiser and loop state training starts from: the seeded initialisation, or
+/// the last checkpoint of `dir` (returned too) when there is one.
+#[allow(clippy::type_complexity)]
+fn start(
+    config: &RunConfig,
+    dir: &RunDir,
+    data: &RecordSet,
+    device: &Device,
+) -> Result<(BrdfModel, ModuleOptimizer, CheckpointState, Option<PathBuf>)> {
+    let t = &config.train;
+    let initial_brdf = (t.output_init == OutputInit::Data).then(|| data.mean_brdf());
+    let model = BrdfModel::init_seeded(&config.model, device, config.seed, initial_brdf)?;
+    let optim = AdamConfig::new().with_epsilon(t.adam_epsilon as f32).init();
+    let last_checkpoint = checkpoint::latest(dir)?;
+    Ok(match &last_checkpoint {
+        Some(c) => {
+            let (model, optim, state) = checkpoint::load(c, model, optim)?;
+            (model, optim, state, last_checkpoint)
+        }
+        None => (model, optim, CheckpointState::default(), None),
+    })
+}
+
+/// Locks the run directory for training: one process at a time, and taking the lock removes the
+/// temporaries of a process killed in it, and the older checkpoints a kill between a
+/// checkpoint's write and their removal left.
+fn lock_run_dir(run: &Path) -> Result<stdx::lock::DirLock> {
+    let lock = stdx::lock::DirLock::acquire(run, "training")?;
+    if lock.removed_temporaries > 0 {
+        eprintln!(
+            "{}: removed {} temporary file(s) of an interrupted write",
+            run.display(),
+            lock.removed_temporaries
+        );
+    }
+    let dir = RunDir::new(run);
+    if let Some((step, _)) = checkpoint::list(&dir)?.pop() {
+        checkpoint::remove_all_but(&dir, step)?;
+    }
+    Ok(lock)
+}
+
+/// The training and validation records' inputs kept on the device when `on_device`: the
+/// training points' spatial rows, the validation points' (on the inference device), and the
+/// training records with their weights and targets.
+#[allow(clippy::type_complexity)]
+fn device_inputs(
+    config: &RunConfig,
+    (data, val): (&RecordSet, &RecordSet),
+    on_device: bool,
+    device: &Device,
+) -> Result<(Option<SpatialTable>, Option<SpatialTable>, Option<DeviceRecords>)> {
+    let spatial = device_table(&config.model, data.points(), on_device, device)?;
+    let val_on_device = on_device && !val.is_empty();
+    let val_spatial =
+        device_table(&config.model, val.points(), val_on_device, &device.clone().inner())?;
+    let (weight, target) = (&data.weight, &data.observed_gamma);
+    let records = device_records(
+        &config.model,
+        data.records(),
+        weight,
+        target,
+        spatial.as_ref(),
+        on_device,
+        device,
+    )?;
+    Ok((spatial, val_spatial, records))
+}
+
+/// Warns when bf16 products on this CPU would be slower than f32 (emulated, or AMX off).
+fn warn_of_slow_bf16(run: &Path, precision: MatmulPrecision, backend: Backend) {
+    if precision != MatmulPrecision::Bf16 || backend.is_gpu() {
+        return;
+    }
+    if !MatmulPrecision::bf16_native() {
+        eprintln!(
+            "{}: warning: matmul_precision = \"bf16\" on a CPU without AVX512-BF16: the products \
+             are emulated, about 2x slower a step than f32 (measured on an Intel Xeon \
+             without it); f32 is the faster choice here",
+            run.display()
+        );
+    } else if MatmulPrecision::cpu_has_amx_bf16() && !MatmulPrecision::bf16_on_amx() {
+        eprintln!(
+            "{}: warning: matmul_precision = \"bf16\" on an Intel CPU with AMX, but the AMX \
+             kernel is off (CPU_KERNELS_AMX=0, or Linux refused the tile registers): the products \
+             run on AVX512-BF16, measured 1.3x slower a step than f32 on such a Xeon \
+             (benches/README.md); f32 is likely the faster choice here",
+            run.display()
+        );
+    }
+}
+
+/// Writes what marks a run finished, in the order a kill anywhere between leaves resumable:
+/// the curve of the last checkpoint again (a kill between that checkpoint and its curve leaves
+/// the previous one's, and a run resumed from its last checkpoint trains no further step that
+/// would write it: the kill torture found such a run), the weights, the same weights for other
+/// tools (safetensors + JSON), and last `metrics.json`, so that a kill before it redoes them all.
+fn write_finished_run(
+    dir: &RunDir,
+    config: &RunConfig,
+    (model, state): (&BrdfModel, &CheckpointState),
+    metrics: &RunMetrics,
+    (scene, cache): (&SceneDataset, &Path),
+) -> Result<()> {
+    write_curve(&dir.curve(), &state.curve)?;
+    save_weights(model, &dir.weights())?;
+    crate::portable::write(dir, &dir.weights(), config, scene, cache)?;
+    metrics.write(&dir.metrics())?;
+    Ok(())
 }
 
 /// The text of a caught panic.

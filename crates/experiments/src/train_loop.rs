@@ -10,7 +10,7 @@ use crate::checkpoint::{self, CheckpointState};
 use crate::data::RecordSet;
 use crate::diagnose::{all_finite, diagnose, worst_input};
 use crate::loss::{LossWeights, loss, srgb_oetf};
-use crate::loss_window::{FreshLeaves, LossWindow, StepLoss, WindowStart};
+use crate::loss_window::{FreshLeaves, LossWindow, ReadStep, StepLoss, WindowStart};
 use crate::{Error, Result};
 use brdf_neural::fitted::{DeviceRecords, predict_on};
 use brdf_neural::precision::PrecisionScope;
@@ -94,6 +94,15 @@ fn tensor(values: Vec<f32>, rows: usize, device: &Device) -> Tensor<2> {
     Tensor::from_data(TensorData::new(values, [rows, 3]), device)
 }
 
+/// Puts the losses of a read window's earlier steps on the curve, every `log_every` steps.
+fn log_losses(state: &mut CheckpointState, earlier: &[ReadStep], log_every: u64) {
+    for s in earlier.iter().filter(|s| s.step.is_multiple_of(log_every)) {
+        let row =
+            CurveRow { step: s.step, loss: s.loss, val_loss: None, lr: s.lr, seconds: s.seconds };
+        state.curve.push(row);
+    }
+}
+
 impl Loop<'_> {
     /// Trains from `state` until the plateau rule or the budget stops it, or until
     /// `stop_after` steps or a stop requested by a signal ([`crate::interrupt`]; then
@@ -162,16 +171,7 @@ impl Loop<'_> {
             };
             timer.charge(Phase::Loss);
             let Some((last, earlier)) = read.split_last() else { continue };
-            for s in earlier.iter().filter(|s| s.step.is_multiple_of(t.log_every)) {
-                let row = CurveRow {
-                    step: s.step,
-                    loss: s.loss,
-                    val_loss: None,
-                    lr: s.lr,
-                    seconds: s.seconds,
-                };
-                state.curve.push(row);
-            }
+            log_losses(&mut state, earlier, t.log_every);
             let (value, lr) = (last.loss, last.lr);
             let val_loss = self.maybe_validate(&model, &mut state)?;
             timer.charge(Phase::Validation);
@@ -182,22 +182,9 @@ impl Loop<'_> {
                 state.curve.push(CurveRow { step: state.step, loss: value, val_loss, lr, seconds });
                 self.report(&state, value, &mut window);
             }
-            if t.snapshots && t.snapshot_steps().contains(&state.step) {
-                self.save_snapshot(&model, state.step)?;
-                state.snapshots.push(Snapshot { step: state.step, seconds });
-            }
-            if state.step >= t.iterations && state.stopped.is_none() {
-                state.stopped = Some(StopReason::Budget);
-            }
+            let progress = (value, seconds, stop_after);
             let interrupted =
-                stop_after.is_some_and(|s| state.step >= s) || crate::interrupt::requested();
-            if state.step.is_multiple_of(t.checkpoint_every)
-                || interrupted
-                || state.stopped.is_some()
-            {
-                state.seconds = seconds;
-                last_checkpoint = Some(self.checkpoint(&model, optim, &state, value)?);
-            }
+                self.save_progress(&model, optim, &mut state, progress, &mut last_checkpoint)?;
             if interrupted && state.stopped.is_none() {
                 self.bar.abandon();
                 return Ok(LoopEnd::Interrupted(state.step));
@@ -206,6 +193,34 @@ impl Loop<'_> {
         timer.charge(Phase::Bookkeeping);
         state.phases = timer.phases().clone();
         Ok(LoopEnd::Done(Box::new((model, state))))
+    }
+
+    /// After a read and its validation: the weight snapshot, the budget's stop and the
+    /// checkpoint (every `checkpoint_every` steps, at a stop and when asked to stop); returns
+    /// whether a stop was asked for (`stop_after` reached, or a signal).
+    fn save_progress(
+        &self,
+        model: &BrdfModel,
+        optim: &ModuleOptimizer,
+        state: &mut CheckpointState,
+        (value, seconds, stop_after): (f32, f64, Option<u64>),
+        last_checkpoint: &mut Option<PathBuf>,
+    ) -> Result<bool> {
+        let t = &self.config.train;
+        if t.snapshots && t.snapshot_steps().contains(&state.step) {
+            self.save_snapshot(model, state.step)?;
+            state.snapshots.push(Snapshot { step: state.step, seconds });
+        }
+        if state.step >= t.iterations && state.stopped.is_none() {
+            state.stopped = Some(StopReason::Budget);
+        }
+        let interrupted =
+            stop_after.is_some_and(|s| state.step >= s) || crate::interrupt::requested();
+        if state.step.is_multiple_of(t.checkpoint_every) || interrupted || state.stopped.is_some() {
+            state.seconds = seconds;
+            *last_checkpoint = Some(self.checkpoint(model, optim, state, value)?);
+        }
+        Ok(interrupted)
     }
 
     /// Whether the losses must be read after `step` steps: every `loss_reads` steps, and

@@ -210,82 +210,19 @@ pub fn render_and_score(
     let bar = progress_bar(t.pairs.len(), opts.progress);
     // One test image per task: rendering, the (up to three) scores and the image files are
     // independent across pairs, and FLIP dominates the cost.
-    let score_pair = |&(vi, li): &(usize, usize)| -> Result<PairScores> {
-        let records = t.records(vi, li);
-        let render = |part: &[[f32; 3]]| t.render(records, part);
-        let img = render(&pred.f);
-        let mask = t.mask(vi);
-        let test = to_image(w, h, &img)?;
-        let observed = to_image(w, h, &dataset.observed_image(vi, li)?)?;
-        let (model, flip) = score(&test, &observed, &mask, opts.lpips, None)?;
-        // Every comparison of a test image shares the observed image's FLIP exposures (a
-        // noise-free image can be black where every lit pixel faces away).
-        let exposures = Some((flip.start_exposure, flip.stop_exposure));
-        let mut scores =
-            PairScores { model, clean: None, ceiling: None, paper: None, paper_observed: None };
-        // The observation with its background set to 0, scored over the whole frame: the
-        // paper's protocol for a capture, its other reading for a generated scene. The masked
-        // LPIPS blacks out both backgrounds: it is the whole frame's here.
-        let reference = background_removed(&observed, &mask)?;
-        let config = metrics::flip::FlipConfig {
-            start_exposure: exposures.map(|e| e.0),
-            stop_exposure: exposures.map(|e| e.1),
-            ..Default::default()
-        };
-        let f = metrics::hdr_flip_with(&test, &reference, None, &config)?;
-        let against_observed = whole_frame(&test, &reference, &f, scores.model.lpips)?;
-        if let Some(noise_free) = dataset.clean_image(vi, li)? {
-            let noise_free = to_image(w, h, &noise_free)?;
-            let (clean, clean_flip) = score(&test, &noise_free, &mask, opts.lpips, exposures)?;
-            // Both images are 0 outside the mask: the masked LPIPS is the whole frame's.
-            scores.paper = Some(whole_frame(&test, &noise_free, &clean_flip, clean.lpips)?);
-            scores.paper_observed = Some(against_observed);
-            scores.clean = Some(clean);
-            if !opts.skip_ceiling {
-                scores.ceiling =
-                    Some(score(&noise_free, &observed, &mask, opts.lpips, exposures)?.0);
-            }
-        } else {
-            scores.paper = Some(against_observed);
-        }
-        if let Some(out) = &out {
-            let stem = format!("view{vi:03}_light{li:03}");
-            out.write_pair(&stem, (w, h), &img, &flip.map, &mask)?;
-            for (name, part) in [("diffuse", &pred.diffuse), ("specular", &pred.specular)] {
-                if let Some(part) = part {
-                    let path = out.renders.join(format!("{stem}_{name}.png"));
-                    write_png_srgb_atomic(&path, w as u32, h as u32, &render(part))?;
-                }
-            }
-        }
+    let one_pair = |&pair: &(usize, usize)| -> Result<PairScores> {
+        let scores = score_pair(&t, (dataset, pred), opts, out.as_ref(), pair)?;
         bar.inc(1);
         Ok(scores)
     };
     let per_pair: Vec<PairScores> = if opts.lpips.is_some() {
         // The LPIPS network runs its own threads; one image at a time.
-        t.pairs.iter().map(score_pair).collect::<Result<_>>()?
+        t.pairs.iter().map(one_pair).collect::<Result<_>>()?
     } else {
-        t.pairs.par_iter().map(score_pair).collect::<Result<_>>()?
+        t.pairs.par_iter().map(one_pair).collect::<Result<_>>()?
     };
     bar.finish_and_clear();
-    let (mut model, mut clean, mut ceiling) = (ImageMetrics::default(), None, None);
-    let (mut paper, mut paper_observed): (Option<ImageMetrics>, Option<ImageMetrics>) =
-        (None, None);
-    for s in &per_pair {
-        model.add(&s.model);
-        if let Some(p) = &s.paper {
-            paper.get_or_insert_with(ImageMetrics::default).add(p);
-        }
-        if let Some(p) = &s.paper_observed {
-            paper_observed.get_or_insert_with(ImageMetrics::default).add(p);
-        }
-        if let Some(c) = &s.clean {
-            clean.get_or_insert_with(ImageMetrics::default).add(c);
-        }
-        if let Some(g) = &s.ceiling {
-            ceiling.get_or_insert_with(ImageMetrics::default).add(g);
-        }
-    }
+    let sums = PairSums::of(&per_pair);
     if let (Some(out), Some(fd)) = (&out, &pred.diffuse_raw) {
         let mut albedo = AlbedoMaps::default();
         for &(vi, li) in &t.pairs {
@@ -296,6 +233,7 @@ pub fn render_and_score(
     }
     let n = t.pairs.len();
     let pixels = t.pairs.iter().map(|&(vi, _)| dataset.geometry.views[vi].pixels.len()).sum();
+    let PairSums { model, clean, ceiling, paper, paper_observed } = sums;
     Ok(ImageScores {
         model: model.divided(n),
         paper: paper.map(|p| p.divided(n)),
@@ -306,6 +244,97 @@ pub fn render_and_score(
         images: n,
         pixels,
     })
+}
+
+/// Renders test pair `(vi, li)`, scores it in every protocol and writes its files (when `out`).
+fn score_pair(
+    t: &TestImages,
+    (dataset, pred): (&SceneDataset, &Prediction),
+    opts: &RenderOptions<'_>,
+    out: Option<&OutputDirs>,
+    (vi, li): (usize, usize),
+) -> Result<PairScores> {
+    let (w, h) = (t.width, t.height);
+    let records = t.records(vi, li);
+    let render = |part: &[[f32; 3]]| t.render(records, part);
+    let img = render(&pred.f);
+    let mask = t.mask(vi);
+    let test = to_image(w, h, &img)?;
+    let observed = to_image(w, h, &dataset.observed_image(vi, li)?)?;
+    let (model, flip) = score(&test, &observed, &mask, opts.lpips, None)?;
+    // Every comparison of a test image shares the observed image's FLIP exposures (a
+    // noise-free image can be black where every lit pixel faces away).
+    let exposures = Some((flip.start_exposure, flip.stop_exposure));
+    let mut scores =
+        PairScores { model, clean: None, ceiling: None, paper: None, paper_observed: None };
+    // The observation with its background set to 0, scored over the whole frame: the
+    // paper's protocol for a capture, its other reading for a generated scene. The masked
+    // LPIPS blacks out both backgrounds: it is the whole frame's here.
+    let reference = background_removed(&observed, &mask)?;
+    let config = metrics::flip::FlipConfig {
+        start_exposure: exposures.map(|e| e.0),
+        stop_exposure: exposures.map(|e| e.1),
+        ..Default::default()
+    };
+    let f = metrics::hdr_flip_with(&test, &reference, None, &config)?;
+    let against_observed = whole_frame(&test, &reference, &f, scores.model.lpips)?;
+    if let Some(noise_free) = dataset.clean_image(vi, li)? {
+        let noise_free = to_image(w, h, &noise_free)?;
+        let (clean, clean_flip) = score(&test, &noise_free, &mask, opts.lpips, exposures)?;
+        // Both images are 0 outside the mask: the masked LPIPS is the whole frame's.
+        scores.paper = Some(whole_frame(&test, &noise_free, &clean_flip, clean.lpips)?);
+        scores.paper_observed = Some(against_observed);
+        scores.clean = Some(clean);
+        if !opts.skip_ceiling {
+            scores.ceiling = Some(score(&noise_free, &observed, &mask, opts.lpips, exposures)?.0);
+        }
+    } else {
+        scores.paper = Some(against_observed);
+    }
+    if let Some(out) = out {
+        let stem = format!("view{vi:03}_light{li:03}");
+        out.write_pair(&stem, (w, h), &img, &flip.map, &mask)?;
+        for (name, part) in [("diffuse", &pred.diffuse), ("specular", &pred.specular)] {
+            if let Some(part) = part {
+                let path = out.renders.join(format!("{stem}_{name}.png"));
+                write_png_srgb_atomic(&path, w as u32, h as u32, &render(part))?;
+            }
+        }
+    }
+    Ok(scores)
+}
+
+/// The per-pair scores summed (each protocol where every pair has it).
+struct PairSums {
+    model: ImageMetrics,
+    clean: Option<ImageMetrics>,
+    ceiling: Option<ImageMetrics>,
+    paper: Option<ImageMetrics>,
+    paper_observed: Option<ImageMetrics>,
+}
+
+impl PairSums {
+    fn of(per_pair: &[PairScores]) -> PairSums {
+        let (mut model, mut clean, mut ceiling) = (ImageMetrics::default(), None, None);
+        let (mut paper, mut paper_observed): (Option<ImageMetrics>, Option<ImageMetrics>) =
+            (None, None);
+        for s in per_pair {
+            model.add(&s.model);
+            if let Some(p) = &s.paper {
+                paper.get_or_insert_with(ImageMetrics::default).add(p);
+            }
+            if let Some(p) = &s.paper_observed {
+                paper_observed.get_or_insert_with(ImageMetrics::default).add(p);
+            }
+            if let Some(c) = &s.clean {
+                clean.get_or_insert_with(ImageMetrics::default).add(c);
+            }
+            if let Some(g) = &s.ceiling {
+                ceiling.get_or_insert_with(ImageMetrics::default).add(g);
+            }
+        }
+        PairSums { model, clean, ceiling, paper, paper_observed }
+    }
 }
 
 /// The scores of one test image.

@@ -181,28 +181,8 @@ pub fn eval_fitted(
     let (rmse_cbrt, rmse_samples) = cube_root_rmse(&samples, &data, &pred.f)?;
     charge(&mut phases.predict);
 
-    let (lpips, lpips_unavailable) = if settings.lpips_weights.is_file() {
-        (Some(metrics::lpips::Lpips::load(&settings.lpips_weights, device)?), None)
-    } else {
-        (None, Some("weights missing".to_string()))
-    };
-    let cached = CeilingCache::new(&fitted.cache, dataset, lpips.is_some());
-    let known = cached.read();
-    let writer = if known.is_none() { cached.claim() } else { None };
-    let opts = images::RenderOptions {
-        run,
-        write: settings.images,
-        lpips: lpips.as_ref(),
-        progress,
-        skip_ceiling: known.is_some(),
-    };
-    let mut scores = images::render_and_score(dataset, &samples, &data, &pred, &opts)?;
-    match (&known, &scores.ceiling) {
-        (Some(c), _) => scores.ceiling = Some(c.clone()),
-        (None, Some(c)) if writer.is_some() => cached.write(c)?,
-        (None, _) => {}
-    }
-    drop(writer);
+    let (scores, lpips_unavailable) =
+        render_and_score(fitted, run, (&samples, &data), &pred, &settings, progress)?;
     charge(&mut phases.images);
     let brdf = NeuralSurface::new(model, &config.model, data.points(), device)?;
     let reciprocity_rmse = analyses::reciprocity(&brdf, &data, &settings)?;
@@ -219,7 +199,66 @@ pub fn eval_fitted(
     let mut all = RunMetrics::read(&path)?;
     let curve = snapshot_curve(fitted, run, &all.snapshots, (&samples, &data))?;
     charge(&mut phases.curve);
-    let test = TestMetrics {
+    let analyses = Analyses { rmse: (rmse_cbrt, rmse_samples), reciprocity_rmse, energy, curve };
+    let test = test_metrics(scores, lpips_unavailable, analyses, dataset, (start, phases));
+    all.test = Some(test.clone());
+    all.write(&path)?;
+    Ok(test)
+}
+
+/// What evaluation computes beside the images.
+struct Analyses {
+    rmse: (Option<f64>, usize),
+    reciprocity_rmse: Option<f64>,
+    energy: Option<EnergySummary>,
+    curve: Vec<CurvePoint>,
+}
+
+/// Renders and scores the test images with LPIPS where its weights are present (else the
+/// reason it is absent), the noise ceiling read from the scene's cache or computed and stored
+/// by the one evaluation that claims it.
+fn render_and_score(
+    fitted: &FittedRun,
+    run: &Path,
+    (samples, data): (&SampleSet, &RecordSet),
+    pred: &Prediction,
+    settings: &run_format::eval_config::EvalSettings,
+    progress: bool,
+) -> Result<(images::ImageScores, Option<String>)> {
+    let (lpips, lpips_unavailable) = if settings.lpips_weights.is_file() {
+        (Some(metrics::lpips::Lpips::load(&settings.lpips_weights, &fitted.device)?), None)
+    } else {
+        (None, Some("weights missing".to_string()))
+    };
+    let cached = CeilingCache::new(&fitted.cache, &fitted.dataset, lpips.is_some());
+    let known = cached.read();
+    let writer = if known.is_none() { cached.claim() } else { None };
+    let opts = images::RenderOptions {
+        run,
+        write: settings.images,
+        lpips: lpips.as_ref(),
+        progress,
+        skip_ceiling: known.is_some(),
+    };
+    let mut scores = images::render_and_score(&fitted.dataset, samples, data, pred, &opts)?;
+    match (&known, &scores.ceiling) {
+        (Some(c), _) => scores.ceiling = Some(c.clone()),
+        (None, Some(c)) if writer.is_some() => cached.write(c)?,
+        (None, _) => {}
+    }
+    Ok((scores, lpips_unavailable))
+}
+
+/// The test record of a run from its scores and analyses.
+fn test_metrics(
+    scores: images::ImageScores,
+    lpips_unavailable: Option<String>,
+    analyses: Analyses,
+    dataset: &scene::SceneDataset,
+    (start, phases): (Instant, EvalPhases),
+) -> TestMetrics {
+    let Analyses { rmse: (rmse_cbrt, rmse_samples), reciprocity_rmse, energy, curve } = analyses;
+    TestMetrics {
         psnr: scores.model.psnr,
         dssim: scores.model.dssim,
         flip: scores.model.flip,
@@ -249,10 +288,7 @@ pub fn eval_fitted(
         )),
         seconds: start.elapsed().as_secs_f64(),
         phases,
-    };
-    all.test = Some(test.clone());
-    all.write(&path)?;
-    Ok(test)
+    }
 }
 
 #[cfg(test)]
