@@ -327,15 +327,21 @@ fn parse_precision(name: &str) -> std::result::Result<MatmulPrecision, String> {
     }
 }
 
+/// `analytic-report`: prints the report and writes it to `out`.
+fn write_analytic_report(options: analytic_report::Options, out: &std::path::Path) -> Result<()> {
+    anyhow::ensure!(options.samples >= 2, "--samples must be at least 2 (got {})", options.samples);
+    anyhow::ensure!(options.pairs >= 1, "--pairs must be at least 1 (got {})", options.pairs);
+    let md = analytic_report::report(&options);
+    print!("{md}");
+    stdx::fs::write_atomic(out, md.as_bytes())?;
+    eprintln!("report written to {}", out.display());
+    Ok(())
+}
+
 fn main() -> Result<()> {
     match Cli::parse().command {
         Command::AnalyticReport { samples, pairs, seed, out } => {
-            anyhow::ensure!(samples >= 2, "--samples must be at least 2 (got {samples})");
-            anyhow::ensure!(pairs >= 1, "--pairs must be at least 1 (got {pairs})");
-            let md = analytic_report::report(&analytic_report::Options { samples, pairs, seed });
-            print!("{md}");
-            stdx::fs::write_atomic(&out, md.as_bytes())?;
-            eprintln!("report written to {}", out.display());
+            write_analytic_report(analytic_report::Options { samples, pairs, seed }, &out)?
         }
         Command::GenerateScenes {
             meshes,

@@ -72,36 +72,10 @@ pub fn reproduce(opts: Options) -> Result<()> {
             lock.removed_temporaries
         );
     }
-    anyhow::ensure!(
-        opts.slurm.is_none() || opts.emit_jobs.is_none(),
-        "--slurm and --emit-jobs are two ways to hand the runs to a cluster: choose one"
-    );
-    let how = match (&opts.emit_jobs, opts.jobs) {
-        _ if opts.slurm.is_some() => Execution::Slurm {
-            program: run_one_command(opts.backend)?.swap_remove(0),
-            backend: opts.backend,
-            options: opts.slurm.clone().unwrap_or_default(),
-        },
-        (Some(file), _) => {
-            Execution::Emit { file: file.clone(), command: run_one_command(opts.backend)? }
-        }
-        (None, 0 | 1) => Execution::InProcess(opts.backend),
-        (None, jobs) => Execution::Children { jobs, command: run_one_command(opts.backend)? },
-    };
+    let how = execution(&opts)?;
     let s = sweep::sweep(&profile, &opts.out, &opts.data_root, &how)
         .with_context(|| format!("sweep {} into {}", profile.name, opts.out.display()))?;
-    eprintln!(
-        "\nscenes: {} generated, {} kept; runs: {} planned, {} finished earlier (skipped), {} completed now, {} failed",
-        s.scenes_generated,
-        s.scenes_kept,
-        s.runs.len(),
-        s.skipped,
-        s.completed,
-        s.failed.len()
-    );
-    for (dir, why) in &s.failed {
-        eprintln!("  failed: {}: {why}", dir.display());
-    }
+    print_sweep(&s);
     if let Some(submission) = &s.submission {
         crate::slurm::print_submission(&opts.out, submission);
         return Ok(());
@@ -137,6 +111,42 @@ pub fn reproduce(opts: Options) -> Result<()> {
         s.failed.len()
     );
     Ok(())
+}
+
+/// How the runs are executed: `--slurm`, `--emit-jobs`, `--jobs N` children or in process.
+fn execution(opts: &Options) -> Result<Execution> {
+    anyhow::ensure!(
+        opts.slurm.is_none() || opts.emit_jobs.is_none(),
+        "--slurm and --emit-jobs are two ways to hand the runs to a cluster: choose one"
+    );
+    Ok(match (&opts.emit_jobs, opts.jobs) {
+        _ if opts.slurm.is_some() => Execution::Slurm {
+            program: run_one_command(opts.backend)?.swap_remove(0),
+            backend: opts.backend,
+            options: opts.slurm.clone().unwrap_or_default(),
+        },
+        (Some(file), _) => {
+            Execution::Emit { file: file.clone(), command: run_one_command(opts.backend)? }
+        }
+        (None, 0 | 1) => Execution::InProcess(opts.backend),
+        (None, jobs) => Execution::Children { jobs, command: run_one_command(opts.backend)? },
+    })
+}
+
+/// The sweep's counts and its failed runs.
+fn print_sweep(s: &sweep::SweepSummary) {
+    eprintln!(
+        "\nscenes: {} generated, {} kept; runs: {} planned, {} finished earlier (skipped), {} completed now, {} failed",
+        s.scenes_generated,
+        s.scenes_kept,
+        s.runs.len(),
+        s.skipped,
+        s.completed,
+        s.failed.len()
+    );
+    for (dir, why) in &s.failed {
+        eprintln!("  failed: {}: {why}", dir.display());
+    }
 }
 
 fn print_results(out: &Path, files: &[PathBuf]) {

@@ -62,73 +62,15 @@ pub fn import_capture(dir: &Path, out: &Path, progress: bool) -> Result<ImportRe
     let lights = Lights::read(&config.lights)?;
     check_counts(&config, &frames, &lights)?;
     let views = group_views(&config, &frames, &lights)?;
-    let size = frames[0].size;
-    if let Some(f) = frames.iter().find(|f| f.size != size) {
-        return Err(Error::input(
-            &config.cameras,
-            format!(
-                "image `{}` is {} x {}, the first {} x {}: a scene has one image size",
-                f.name, f.size.0, f.size.1, size.0, size.1
-            ),
-        ));
-    }
+    let size = image_size(&config, &frames)?;
     let loaded = mesh_encoding::load_mesh(&config.mesh, &mesh_encoding::LoadOptions::default())?;
     let mesh = loaded.mesh;
     let (min, max) = mesh.bounding_box();
     let centre = 0.5 * (min + max);
     let radius = 0.5 * mesh.diagonal();
 
-    let mut ray_views = Vec::with_capacity(views.len());
-    let mut infos = Vec::with_capacity(views.len());
-    for v in &views {
-        let f = &frames[v.frames[0]];
-        let k = f.k.map(|r| r.map(|x| x as f32));
-        let r = f.r.map(|r| r.map(|x| x as f32));
-        let t = f.t.map(|x| x as f32);
-        let camera = Camera::from_opencv(
-            mat3_from_rows(k),
-            mat3_from_rows(r),
-            Vec3::from_array(t),
-            size.0,
-            size.1,
-        )
-        .map_err(|e| Error::input(&f.image, format!("its camera: {e}")))?;
-        let infos_l: Vec<LightInfo> = v
-            .frames
-            .iter()
-            .map(|&i| {
-                light_info(lights.get(&frames[i].name).expect("checked").light, v.split, centre)
-            })
-            .collect();
-        ray_views.push(View {
-            camera,
-            lights: infos_l.iter().map(LightInfo::source).collect(),
-            mask: None,
-        });
-        infos.push(ViewInfo { split: v.split, k, r, t, lights: infos_l });
-    }
-    let mean_distance =
-        ray_views.iter().map(|v| (v.camera.center() - centre).length()).sum::<f32>()
-            / ray_views.len() as f32;
-    let f_y = ray_views[0].camera.k.y_axis.y;
-    let train_views = views.iter().filter(|v| v.split == Split::Train).count();
-    let lights_per_view = views.iter().map(|v| v.frames.len()).max().unwrap_or(0);
-    let settings = SceneSettings {
-        width: size.0,
-        height: size.1,
-        views: views.len(),
-        train_views,
-        lights_per_view,
-        train_lights: lights_per_view,
-        fov_y_deg: 2.0 * (0.5 * size.1 as f32 / f_y).atan().to_degrees(),
-        // In mesh radii from the mesh's centre (recorded for information; at least just above 1).
-        camera_distance: (mean_distance / radius.max(f32::MIN_POSITIVE)).max(1.0001),
-        light_intensity: [1.0; 3],
-        noise_sigma: 0.0,
-        saturation: config.image.saturation.unwrap_or(f32::MAX),
-        up_axis: UpAxis::Z,
-        ..SceneSettings::default()
-    };
+    let (ray_views, infos) = ray_views(&views, &frames, &lights, size, centre)?;
+    let settings = scene_settings(&config, &views, &ray_views, size, (centre, radius));
     let object = dir
         .canonicalize()
         .ok()
@@ -147,29 +89,8 @@ pub fn import_capture(dir: &Path, out: &Path, progress: bool) -> Result<ImportRe
     // first pair refuses a misaligned capture before any image is written.
     let checks: Mutex<Vec<Option<ViewCheck>>> = Mutex::new(vec![None; views.len()]);
     let mask = |vi: usize, g: &ViewPrecompute| {
-        let v = &views[vi];
-        let mut m = vec![0u8; (g.width * g.height) as usize];
-        let mut both = 0u64;
-        for &p in &g.pixels {
-            if v.mask.as_ref().is_none_or(|mask| mask[p as usize]) {
-                m[p as usize] = 255;
-                both += 1;
-            }
-        }
-        let mesh_pixels = g.pixels.len() as u64;
-        let mask_pixels =
-            v.mask.as_ref().map_or(mesh_pixels, |mk| mk.iter().filter(|&&b| b).count() as u64);
-        let union = mask_pixels + mesh_pixels - both;
-        let iou =
-            v.mask.as_ref().map(|_| if union == 0 { 0.0 } else { both as f64 / union as f64 });
-        checks.lock().unwrap()[vi] = Some(ViewCheck {
-            images: v.frames.iter().map(|&i| frames[i].name.clone()).collect(),
-            split: v.split,
-            mask_pixels,
-            mesh_pixels,
-            both_pixels: both,
-            iou,
-        });
+        let (m, check) = view_check(&views[vi], &frames, g);
+        checks.lock().unwrap()[vi] = Some(check);
         m
     };
     let min_iou = config.check.min_iou;
@@ -210,6 +131,121 @@ pub fn import_capture(dir: &Path, out: &Path, progress: bool) -> Result<ImportRe
     let views =
         checks.into_inner().unwrap().into_iter().map(|c| c.expect("every view traced")).collect();
     Ok(ImportReport { manifest: written.manifest, views })
+}
+
+/// The capture's one image size (every image must have it).
+fn image_size(config: &CaptureConfig, frames: &[Frame]) -> Result<(u32, u32)> {
+    let size = frames[0].size;
+    if let Some(f) = frames.iter().find(|f| f.size != size) {
+        return Err(Error::input(
+            &config.cameras,
+            format!(
+                "image `{}` is {} x {}, the first {} x {}: a scene has one image size",
+                f.name, f.size.0, f.size.1, size.0, size.1
+            ),
+        ));
+    }
+    Ok(size)
+}
+
+/// Each view's camera and lights, as the ray caster and the manifest take them.
+fn ray_views(
+    views: &[CaptureView],
+    frames: &[Frame],
+    lights: &Lights,
+    size: (u32, u32),
+    centre: Vec3,
+) -> Result<(Vec<View>, Vec<ViewInfo>)> {
+    let mut ray_views = Vec::with_capacity(views.len());
+    let mut infos = Vec::with_capacity(views.len());
+    for v in views {
+        let f = &frames[v.frames[0]];
+        let k = f.k.map(|r| r.map(|x| x as f32));
+        let r = f.r.map(|r| r.map(|x| x as f32));
+        let t = f.t.map(|x| x as f32);
+        let camera = Camera::from_opencv(
+            mat3_from_rows(k),
+            mat3_from_rows(r),
+            Vec3::from_array(t),
+            size.0,
+            size.1,
+        )
+        .map_err(|e| Error::input(&f.image, format!("its camera: {e}")))?;
+        let infos_l: Vec<LightInfo> = v
+            .frames
+            .iter()
+            .map(|&i| {
+                light_info(lights.get(&frames[i].name).expect("checked").light, v.split, centre)
+            })
+            .collect();
+        ray_views.push(View {
+            camera,
+            lights: infos_l.iter().map(LightInfo::source).collect(),
+            mask: None,
+        });
+        infos.push(ViewInfo { split: v.split, k, r, t, lights: infos_l });
+    }
+    Ok((ray_views, infos))
+}
+
+/// The scene settings a capture implies: its image size, views and lights, the cameras' field
+/// of view and mean distance (in mesh radii from the mesh's centre), its saturation.
+fn scene_settings(
+    config: &CaptureConfig,
+    views: &[CaptureView],
+    ray_views: &[View],
+    size: (u32, u32),
+    (centre, radius): (Vec3, f32),
+) -> SceneSettings {
+    let mean_distance =
+        ray_views.iter().map(|v| (v.camera.center() - centre).length()).sum::<f32>()
+            / ray_views.len() as f32;
+    let f_y = ray_views[0].camera.k.y_axis.y;
+    let train_views = views.iter().filter(|v| v.split == Split::Train).count();
+    let lights_per_view = views.iter().map(|v| v.frames.len()).max().unwrap_or(0);
+    SceneSettings {
+        width: size.0,
+        height: size.1,
+        views: views.len(),
+        train_views,
+        lights_per_view,
+        train_lights: lights_per_view,
+        fov_y_deg: 2.0 * (0.5 * size.1 as f32 / f_y).atan().to_degrees(),
+        // In mesh radii from the mesh's centre (recorded for information; at least just above 1).
+        camera_distance: (mean_distance / radius.max(f32::MIN_POSITIVE)).max(1.0001),
+        light_intensity: [1.0; 3],
+        noise_sigma: 0.0,
+        saturation: config.image.saturation.unwrap_or(f32::MAX),
+        up_axis: UpAxis::Z,
+        ..SceneSettings::default()
+    }
+}
+
+/// A view's object mask as the scene stores it (the capture's mask within the mesh's
+/// silhouette, 255 inside) and the two's agreement.
+fn view_check(v: &CaptureView, frames: &[Frame], g: &ViewPrecompute) -> (Vec<u8>, ViewCheck) {
+    let mut m = vec![0u8; (g.width * g.height) as usize];
+    let mut both = 0u64;
+    for &p in &g.pixels {
+        if v.mask.as_ref().is_none_or(|mask| mask[p as usize]) {
+            m[p as usize] = 255;
+            both += 1;
+        }
+    }
+    let mesh_pixels = g.pixels.len() as u64;
+    let mask_pixels =
+        v.mask.as_ref().map_or(mesh_pixels, |mk| mk.iter().filter(|&&b| b).count() as u64);
+    let union = mask_pixels + mesh_pixels - both;
+    let iou = v.mask.as_ref().map(|_| if union == 0 { 0.0 } else { both as f64 / union as f64 });
+    let check = ViewCheck {
+        images: v.frames.iter().map(|&i| frames[i].name.clone()).collect(),
+        split: v.split,
+        mask_pixels,
+        mesh_pixels,
+        both_pixels: both,
+        iou,
+    };
+    (m, check)
 }
 
 /// Every image has exactly one light and every light an image.

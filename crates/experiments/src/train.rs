@@ -257,23 +257,9 @@ pub fn fit_and_keep(
     // GPU's matrix-product kernels do not split it themselves. The CPU keeps the plain product.
     let parts = if options.backend.is_gpu() { batch_split::gpu_parts(t.batch_size) } else { 1 };
     let split = batch_split::scope(parts);
-    // burn and CubeCL panic when a GPU runs out of memory or is lost: end with an error that
-    // says so and names the checkpoint that resumes, as for any other failure.
     let (hook, stop_after) = (options.hook, options.stop_after);
     let run_loop = || lp.run(model, &mut optim, state, last_checkpoint, hook, stop_after);
-    let end = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run_loop)) {
-        Ok(end) => end?,
-        Err(payload) => {
-            lp.bar.abandon();
-            return Err(Error::BackendFault {
-                run: run.to_path_buf(),
-                step: lp.bar.position(),
-                backend: options.backend.to_string(),
-                message: panic_message(payload.as_ref()),
-                checkpoint: checkpoint::latest(&dir)?,
-            });
-        }
-    };
+    let end = guarded(run_loop, &lp, (&dir, options.backend))?;
     drop((precision, split));
     let (model, state) = match end {
         LoopEnd::Done(done) => *done,
@@ -403,6 +389,29 @@ fn write_finished_run(
     crate::portable::write(dir, &dir.weights(), config, scene, cache)?;
     metrics.write(&dir.metrics())?;
     Ok(())
+}
+
+/// Runs the training loop with a panic in it turned into an error: burn and CubeCL panic when a
+/// GPU runs out of memory or is lost, and the error says so and names the checkpoint that
+/// resumes the run, as for any other failure.
+fn guarded(
+    run_loop: impl FnOnce() -> Result<LoopEnd>,
+    lp: &Loop<'_>,
+    (dir, backend): (&RunDir, Backend),
+) -> Result<LoopEnd> {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run_loop)) {
+        Ok(end) => end,
+        Err(payload) => {
+            lp.bar.abandon();
+            Err(Error::BackendFault {
+                run: dir.path().to_path_buf(),
+                step: lp.bar.position(),
+                backend: backend.to_string(),
+                message: panic_message(payload.as_ref()),
+                checkpoint: checkpoint::latest(dir)?,
+            })
+        }
+    }
 }
 
 /// The text of a caught panic.

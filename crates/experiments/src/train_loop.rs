@@ -140,14 +140,8 @@ impl Loop<'_> {
             let lr = t.lr_at(step) * state.plateau.lr_scale;
             timer.charge(Phase::Bookkeeping);
             let loss;
-            // The process's first step is read at once: its end is the start-up's.
-            let first = self.startup_seconds.get().is_none();
-            let read_now = self.loss_reads == 1 || first;
             (model, loss) =
-                self.step(model, optim, (step, lr), &last_checkpoint, &mut timer, read_now)?;
-            if first {
-                self.startup_seconds.set(Some(self.started.elapsed().as_secs_f64()));
-            }
+                self.timed_step(model, optim, (step, lr), &last_checkpoint, &mut timer)?;
             state.step += 1;
             losses.push(state.step, lr, seconds_before + start.elapsed().as_secs_f64(), loss);
             self.bar.set_position(state.step);
@@ -273,6 +267,25 @@ impl Loop<'_> {
             }
         }
         not_reproduced(&format!("replaying steps {first}..={bad} did not repeat it"))
+    }
+
+    /// [`Loop::step`], its loss read at once every `loss_reads` steps or when it is the
+    /// process's first step, whose end is the start-up's (recorded).
+    fn timed_step(
+        &self,
+        model: BrdfModel,
+        optim: &mut ModuleOptimizer,
+        (step, lr): (u64, f64),
+        last_checkpoint: &Option<PathBuf>,
+        timer: &mut PhaseTimer,
+    ) -> Result<(BrdfModel, StepLoss)> {
+        let first = self.startup_seconds.get().is_none();
+        let read_now = self.loss_reads == 1 || first;
+        let out = self.step(model, optim, (step, lr), last_checkpoint, timer, read_now)?;
+        if first {
+            self.startup_seconds.set(Some(self.started.elapsed().as_secs_f64()));
+        }
+        Ok(out)
     }
 
     /// One optimiser step number `step` at rate `lr`: the batch of `step`, the loss, its

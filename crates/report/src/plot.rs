@@ -264,12 +264,7 @@ where
             .label_font(font(px))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
-            .position(match plot.legend {
-                LegendCorner::UpperLeft => SeriesLabelPosition::UpperLeft,
-                LegendCorner::UpperRight => SeriesLabelPosition::UpperRight,
-                LegendCorner::LowerLeft => SeriesLabelPosition::LowerLeft,
-                LegendCorner::LowerRight => SeriesLabelPosition::LowerRight,
-            })
+            .position(legend_position(plot.legend))
             .draw()
             .map_err(draw_error)?;
     }
@@ -279,6 +274,16 @@ where
         root.draw_text("no data", &style, ((w / 2) as i32, (h / 2) as i32)).map_err(draw_error)?;
     }
     Ok(())
+}
+
+/// Where plotters puts the legend for `corner`.
+fn legend_position(corner: LegendCorner) -> SeriesLabelPosition {
+    match corner {
+        LegendCorner::UpperLeft => SeriesLabelPosition::UpperLeft,
+        LegendCorner::UpperRight => SeriesLabelPosition::UpperRight,
+        LegendCorner::LowerLeft => SeriesLabelPosition::LowerLeft,
+        LegendCorner::LowerRight => SeriesLabelPosition::LowerRight,
+    }
 }
 
 /// Marker shape `i % 5` (circle, square, triangle, cross, ring) of radius `r` at pixel offset

@@ -116,31 +116,8 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
         figures(&runs, out, &mut summary)?;
         super::brdf_figures::brdf_figures(&runs, out, &mut summary)?;
     }
-    let curves: Vec<RunRecord> = runs
-        .iter()
-        .filter(|r| r.purposes.contains(&Purpose::Runtime))
-        .flat_map(|r| r.curve.iter().cloned())
-        .collect();
-    if !curves.is_empty() {
-        let t = report::time_to_accuracy(&curves, &ceiling, profile);
-        let runtime = [("runtime".to_string(), t)];
-        write_tables(&runtime, out, &mut all_md, &mut summary)?;
-        all_tables.extend(runtime);
-        let c = ceiling_psnr(&ceiling, &curves);
-        for (metric, name) in [(MetricKind::Psnr, "psnr"), (MetricKind::CubeRootRmse, "rmse")] {
-            let reference = if metric == MetricKind::Psnr { c } else { None };
-            let d = Dataset::MerlNbrdf;
-            let plot = report::runtime_plot(&curves, &d, metric, reference, profile);
-            if !plot.series.is_empty() {
-                let png = report::line_plot_png(&plot)?;
-                write(
-                    SweepLayout::new(out).figures().join(format!("runtime-{name}.png")),
-                    &png,
-                    &mut summary,
-                )?;
-            }
-        }
-    }
+    let sink = (&mut all_md, &mut all_tables, &mut summary);
+    runtime_outputs(&runs, &ceiling, (out, profile), sink)?;
     // Where the time went: the last sweep into `out` (if one wrote its timing) and the runs'.
     let timing = super::timing::SweepTiming::read(out);
     let time = [("time".to_string(), super::timing::table(timing.as_ref(), &runs, profile))];
@@ -150,6 +127,42 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<CollectSu
     let tables = super::html_report::Tables { all: &all_tables, paper: comparison.as_ref() };
     super::html_report::write_report(out, profile, &tables, &runs, &mut summary)?;
     Ok(summary)
+}
+
+/// The run-time table and curves of the runs that record them (`Purpose::Runtime`), into
+/// `all_md`, `all_tables` and `summary`.
+fn runtime_outputs(
+    runs: &[CollectedRun],
+    ceiling: &[RunRecord],
+    (out, profile): (&Path, &str),
+    (all_md, all_tables, summary): (&mut String, &mut Vec<(String, Table)>, &mut CollectSummary),
+) -> Result<()> {
+    let curves: Vec<RunRecord> = runs
+        .iter()
+        .filter(|r| r.purposes.contains(&Purpose::Runtime))
+        .flat_map(|r| r.curve.iter().cloned())
+        .collect();
+    if !curves.is_empty() {
+        let t = report::time_to_accuracy(&curves, ceiling, profile);
+        let runtime = [("runtime".to_string(), t)];
+        write_tables(&runtime, out, all_md, summary)?;
+        all_tables.extend(runtime);
+        let c = ceiling_psnr(ceiling, &curves);
+        for (metric, name) in [(MetricKind::Psnr, "psnr"), (MetricKind::CubeRootRmse, "rmse")] {
+            let reference = if metric == MetricKind::Psnr { c } else { None };
+            let d = Dataset::MerlNbrdf;
+            let plot = report::runtime_plot(&curves, &d, metric, reference, profile);
+            if !plot.series.is_empty() {
+                let png = report::line_plot_png(&plot)?;
+                write(
+                    SweepLayout::new(out).figures().join(format!("runtime-{name}.png")),
+                    &png,
+                    summary,
+                )?;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The records of the runs under the other protocols than ours.

@@ -7,10 +7,10 @@ use crate::plan::{self, Purpose};
 use experiments::Result;
 use metrics::aggregate::Score;
 use report::{Dataset, MetricKind, RunOptions, RunRecord};
-use run_format::ImageMetrics;
 use run_format::config::RunConfig;
 use run_format::plateau::StopReason;
 use run_format::run_dir::{RunDir, RunMetrics};
+use run_format::{ImageMetrics, TestMetrics};
 use std::path::{Path, PathBuf};
 
 /// One collected run.
@@ -80,22 +80,7 @@ pub fn read_run(dir: &Path) -> Result<Option<CollectedRun>> {
     let config = run.read_config()?;
     let m = RunMetrics::read(&run.metrics())?;
     let Some(t) = m.test.as_ref() else { return Ok(None) };
-    let (object, dataset, purposes) = match plan::read_info(&run) {
-        Ok(i) => (i.object, Dataset::from_label(&i.dataset), i.purposes),
-        Err(_) => {
-            let object = config
-                .scene
-                .as_ref()
-                .and_then(|s| s.file_name())
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_else(|| "unknown".into());
-            (
-                object,
-                scene_dataset(config.scene.as_deref()),
-                vec![Purpose::Table, Purpose::Ablation],
-            )
-        }
-    };
+    let (object, dataset, purposes) = run_identity(&run, &config);
     let opt = |v: Option<f64>, why: &str| match v {
         Some(x) => Score::Value(x),
         None => Score::Unavailable(why.into()),
@@ -139,6 +124,47 @@ pub fn read_run(dir: &Path) -> Result<Option<CollectedRun>> {
         (None, Some(_)) => None,
     });
     let ceiling = t.ceiling.as_ref().map(|c| images(base.clone(), c));
+    let curve = curve_records(&base, &m, t);
+    Ok(Some(CollectedRun {
+        dir: dir.to_path_buf(),
+        config,
+        purposes,
+        record: r,
+        noise_free,
+        ceiling,
+        paper,
+        paper_observed,
+        curve,
+        stop_reason: m.stop_reason,
+        train_seconds: m.wall_seconds,
+        eval_seconds: t.seconds,
+    }))
+}
+
+/// The run's object, data set and purposes, from its `run.json` or, for a run made outside a
+/// sweep, from its scene's folder name (purposes: a table row and an ablation).
+fn run_identity(run: &RunDir, config: &RunConfig) -> (String, Dataset, Vec<Purpose>) {
+    match plan::read_info(run) {
+        Ok(i) => (i.object, Dataset::from_label(&i.dataset), i.purposes),
+        Err(_) => {
+            let object = config
+                .scene
+                .as_ref()
+                .and_then(|s| s.file_name())
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "unknown".into());
+            (
+                object,
+                scene_dataset(config.scene.as_deref()),
+                vec![Purpose::Table, Purpose::Ablation],
+            )
+        }
+    }
+}
+
+/// The run-time curve of a run whose profile kept weight snapshots: each snapshot's test
+/// scores, then the final weights'.
+fn curve_records(base: &RunRecord, m: &RunMetrics, t: &TestMetrics) -> Vec<RunRecord> {
     let point = |steps: u64, seconds: f64, psnr: f64, rmse: Option<f64>| {
         let p = base
             .clone()
@@ -155,20 +181,7 @@ pub fn read_run(dir: &Path) -> Result<Option<CollectedRun>> {
     if !curve.is_empty() {
         curve.push(point(m.steps, m.wall_seconds, t.psnr, t.rmse_cbrt));
     }
-    Ok(Some(CollectedRun {
-        dir: dir.to_path_buf(),
-        config,
-        purposes,
-        record: r,
-        noise_free,
-        ceiling,
-        paper,
-        paper_observed,
-        curve,
-        stop_reason: m.stop_reason,
-        train_seconds: m.wall_seconds,
-        eval_seconds: t.seconds,
-    }))
+    curve
 }
 
 /// The note under the tables when runs stopped before converging, naming them.

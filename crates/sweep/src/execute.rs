@@ -17,6 +17,7 @@ use dataset_merl::generate_scene;
 use experiments::fitted::FittedRun;
 use experiments::train::fit_and_keep;
 use experiments::{Error, FitOptions, FitOutcome, Result};
+use indicatif::ProgressBar;
 use run_format::config::SpatialKind;
 use run_format::run_dir::{RunDir, SweepLayout};
 use scene::SceneDataset;
@@ -306,95 +307,124 @@ pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) ->
         Execution::Emit { .. } | Execution::Slurm { .. } => Heartbeat::start(0, 1),
     };
     match how {
-        Execution::InProcess(backend) => {
-            for d in &todo {
-                bar.set_message(short(d));
-                lines.started(d);
-                match bar.suspend(|| run_one(d, true, *backend)) {
-                    Ok(RunEnd::Interrupted(_)) => {
-                        summary.failed.push(((*d).clone(), "interrupted by a signal".into()));
-                        lines.finished(d, false);
-                    }
-                    Ok(RunEnd::Done) => {
-                        summary.completed += 1;
-                        lines.finished(d, true);
-                    }
-                    Err(e) => {
-                        summary.failed.push(((*d).clone(), e.to_string()));
-                        lines.finished(d, false);
-                    }
-                }
-                bar.inc(1);
-            }
-        }
+        Execution::InProcess(backend) => run_in_process(&todo, *backend, (&bar, &lines), summary),
         Execution::Children { jobs, command } => {
-            let (program, args) =
-                command.split_first().ok_or_else(|| Error::config("jobs", "no command"))?;
-            let mut queue = todo.iter();
-            let mut running: Vec<(PathBuf, std::process::Child)> = Vec::new();
-            loop {
-                while running.len() < (*jobs).max(1) {
-                    let Some(d) = queue.next() else { break };
-                    let log = RunDir::new(d.as_path()).log();
-                    std::fs::create_dir_all(d).map_err(|e| Error::io(d, e))?;
-                    let file = std::fs::File::create(&log).map_err(|e| Error::io(&log, e))?;
-                    let err = file.try_clone().map_err(|e| Error::io(&log, e))?;
-                    let child = Command::new(program)
-                        .args(args)
-                        .env(PARENT_PID_VAR, std::process::id().to_string())
-                        .arg(d.as_path())
-                        .stdout(file)
-                        .stderr(err)
-                        .spawn()
-                        .map_err(|e| Error::io(Path::new(program), e))?;
-                    lines.started(d);
-                    running.push(((*d).clone(), child));
-                }
-                if running.is_empty() {
-                    break;
-                }
-                std::thread::sleep(std::time::Duration::from_millis(200));
-                let mut i = 0;
-                while i < running.len() {
-                    if let Some(status) =
-                        running[i].1.try_wait().map_err(|e| Error::io(&running[i].0, e))?
-                    {
-                        let (d, _) = running.swap_remove(i);
-                        let ok = status.success() && is_done(&d);
-                        lines.finished(&d, ok);
-                        if ok {
-                            summary.completed += 1;
-                        } else {
-                            let log = RunDir::new(&d).log();
-                            summary.failed.push((
-                                d.clone(),
-                                format!("{status}: {}; see {}", last_error(&log), log.display()),
-                            ));
-                        }
-                        bar.inc(1);
-                    } else {
-                        i += 1;
-                    }
-                }
-                bar.set_message(format!("{} running", running.len()));
-            }
+            run_children(&todo, (*jobs, command.as_slice()), (&bar, &lines), summary)?
         }
         Execution::Emit { file, command } => {
-            let mut text = String::new();
-            for d in &todo {
-                let abs = std::path::absolute(d).map_err(|e| Error::io(d, e))?;
-                let mut parts: Vec<String> = command.iter().map(|c| shell::quote(c)).collect();
-                parts.push(shell::quote(&abs.display().to_string()));
-                text.push_str(&parts.join(" "));
-                text.push('\n');
-            }
-            stdx::fs::write_atomic(file, text.as_bytes())?;
-            summary.emitted = todo.len();
+            emit_jobs(&todo, (file.as_path(), command.as_slice()), summary)?
         }
         // Submitted by `sweep`, which knows the output directory.
         Execution::Slurm { .. } => {}
     }
     bar.finish_and_clear();
+    Ok(())
+}
+
+/// Runs `todo` one after the other in this process.
+fn run_in_process(
+    todo: &[&PathBuf],
+    backend: Backend,
+    (bar, lines): (&ProgressBar, &Heartbeat),
+    summary: &mut SweepSummary,
+) {
+    for d in todo {
+        bar.set_message(short(d));
+        lines.started(d);
+        match bar.suspend(|| run_one(d, true, *backend)) {
+            Ok(RunEnd::Interrupted(_)) => {
+                summary.failed.push(((*d).clone(), "interrupted by a signal".into()));
+                lines.finished(d, false);
+            }
+            Ok(RunEnd::Done) => {
+                summary.completed += 1;
+                lines.finished(d, true);
+            }
+            Err(e) => {
+                summary.failed.push(((*d).clone(), e.to_string()));
+                lines.finished(d, false);
+            }
+        }
+        bar.inc(1);
+    }
+}
+
+/// Runs `todo` as child processes of `command`, `jobs` at a time, each writing its run's log.
+fn run_children(
+    todo: &[&PathBuf],
+    (jobs, command): (usize, &[String]),
+    (bar, lines): (&ProgressBar, &Heartbeat),
+    summary: &mut SweepSummary,
+) -> Result<()> {
+    let (program, args) =
+        command.split_first().ok_or_else(|| Error::config("jobs", "no command"))?;
+    let mut queue = todo.iter();
+    let mut running: Vec<(PathBuf, std::process::Child)> = Vec::new();
+    loop {
+        while running.len() < jobs.max(1) {
+            let Some(d) = queue.next() else { break };
+            let log = RunDir::new(d.as_path()).log();
+            std::fs::create_dir_all(d).map_err(|e| Error::io(d, e))?;
+            let file = std::fs::File::create(&log).map_err(|e| Error::io(&log, e))?;
+            let err = file.try_clone().map_err(|e| Error::io(&log, e))?;
+            let child = Command::new(program)
+                .args(args)
+                .env(PARENT_PID_VAR, std::process::id().to_string())
+                .arg(d.as_path())
+                .stdout(file)
+                .stderr(err)
+                .spawn()
+                .map_err(|e| Error::io(Path::new(program), e))?;
+            lines.started(d);
+            running.push(((*d).clone(), child));
+        }
+        if running.is_empty() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(200));
+        let mut i = 0;
+        while i < running.len() {
+            if let Some(status) =
+                running[i].1.try_wait().map_err(|e| Error::io(&running[i].0, e))?
+            {
+                let (d, _) = running.swap_remove(i);
+                let ok = status.success() && is_done(&d);
+                lines.finished(&d, ok);
+                if ok {
+                    summary.completed += 1;
+                } else {
+                    let log = RunDir::new(&d).log();
+                    summary.failed.push((
+                        d.clone(),
+                        format!("{status}: {}; see {}", last_error(&log), log.display()),
+                    ));
+                }
+                bar.inc(1);
+            } else {
+                i += 1;
+            }
+        }
+        bar.set_message(format!("{} running", running.len()));
+    }
+    Ok(())
+}
+
+/// Writes one shell line a run of `todo` (`command` and the run's absolute path) to `file`.
+fn emit_jobs(
+    todo: &[&PathBuf],
+    (file, command): (&Path, &[String]),
+    summary: &mut SweepSummary,
+) -> Result<()> {
+    let mut text = String::new();
+    for d in todo {
+        let abs = std::path::absolute(d).map_err(|e| Error::io(d, e))?;
+        let mut parts: Vec<String> = command.iter().map(|c| shell::quote(c)).collect();
+        parts.push(shell::quote(&abs.display().to_string()));
+        text.push_str(&parts.join(" "));
+        text.push('\n');
+    }
+    stdx::fs::write_atomic(file, text.as_bytes())?;
+    summary.emitted = todo.len();
     Ok(())
 }
 

@@ -132,31 +132,7 @@ pub fn write_report(
             paper_section(&mut index, c);
         }
     }
-    let qualitative = figures_matching(&dir, summary, "qualitative-");
-    let split = figures_matching(&dir, summary, "split-");
-    if !qualitative.is_empty() || !split.is_empty() {
-        index.heading("Qualitative comparison", "qualitative");
-        for f in qualitative.into_iter().chain(split) {
-            index.figures(&[f]);
-        }
-    }
-    let brdf: Vec<(String, String)> = ["spheres-", "slices-", "albedo-", "validity-"]
-        .iter()
-        .flat_map(|p| figures_matching(&dir, summary, p))
-        .collect();
-    if !brdf.is_empty() {
-        index.heading("BRDF plots", "brdf");
-        index.paragraph(
-            "Each fitted model and the ground-truth material away from the cameras' \
-             directions: lit spheres with their HDR-FLIP error, slices in the plane of \
-             incidence (linear and log10), directional albedo against the incident angle \
-             (above 1 the BRDF creates energy), and per-pixel validity on a test view.",
-            true,
-        );
-        for f in brdf {
-            index.figures(&[f]);
-        }
-    }
+    figure_sections(&mut index, &dir, summary);
     let mut sorted: Vec<&CollectedRun> = runs.iter().collect();
     sorted.sort_by(|a, b| {
         (&a.record.object, a.record.model as usize, a.record.options.label()).cmp(&(
@@ -175,10 +151,48 @@ pub fn write_report(
         pages.push((page, html));
     }
     pages.push((dir.join("index.html"), index.finish()));
-    // Every page is checked before any is written: well formed, and each link names a file
-    // that exists or a page of this report.
+    check_pages(&pages)?;
+    for (path, html) in pages {
+        stdx::fs::write_atomic(&path, html.as_bytes())?;
+        summary.files.push(path);
+    }
+    Ok(())
+}
+
+/// The index's figure sections: the qualitative comparison and the BRDF plots.
+fn figure_sections(index: &mut Page, dir: &Path, summary: &CollectSummary) {
+    let qualitative = figures_matching(dir, summary, "qualitative-");
+    let split = figures_matching(dir, summary, "split-");
+    if !qualitative.is_empty() || !split.is_empty() {
+        index.heading("Qualitative comparison", "qualitative");
+        for f in qualitative.into_iter().chain(split) {
+            index.figures(&[f]);
+        }
+    }
+    let brdf: Vec<(String, String)> = ["spheres-", "slices-", "albedo-", "validity-"]
+        .iter()
+        .flat_map(|p| figures_matching(dir, summary, p))
+        .collect();
+    if !brdf.is_empty() {
+        index.heading("BRDF plots", "brdf");
+        index.paragraph(
+            "Each fitted model and the ground-truth material away from the cameras' \
+             directions: lit spheres with their HDR-FLIP error, slices in the plane of \
+             incidence (linear and log10), directional albedo against the incident angle \
+             (above 1 the BRDF creates energy), and per-pixel validity on a test view.",
+            true,
+        );
+        for f in brdf {
+            index.figures(&[f]);
+        }
+    }
+}
+
+/// Checks every page before any is written: well formed, and each link names a file that
+/// exists or a page of this report.
+fn check_pages(pages: &[(PathBuf, String)]) -> Result<()> {
     let pending: Vec<PathBuf> = pages.iter().map(|(p, _)| lexical(p)).collect();
-    for (path, html) in &pages {
+    for (path, html) in pages {
         check_well_formed(html).map_err(|e| Error::format(path, e))?;
         let base = path.parent().unwrap_or(Path::new("."));
         for link in links(html) {
@@ -187,10 +201,6 @@ pub fn write_report(
                 return Err(Error::format(path, format!("links to {link}, which does not exist")));
             }
         }
-    }
-    for (path, html) in pages {
-        stdx::fs::write_atomic(&path, html.as_bytes())?;
-        summary.files.push(path);
     }
     Ok(())
 }

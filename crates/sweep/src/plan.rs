@@ -179,36 +179,7 @@ pub fn runs(profile: &SweepProfile) -> Result<Vec<RunSpec>> {
             }
         }
         for ablation in profile.ablations()? {
-            let variants: Vec<(ModelKind, RunOptions)> = match ablation {
-                Ablation::Nol => {
-                    neural.iter().map(|&k| (k, RunOptions { nol: true, ..d })).collect()
-                }
-                Ablation::Reciprocity => neural
-                    .iter()
-                    .copied()
-                    .flat_map(|k| {
-                        [Reciprocity::RandomSwap, Reciprocity::Mapping]
-                            .map(|r| (k, RunOptions { reciprocity: r, ..d }))
-                    })
-                    .collect(),
-                Ablation::Angles => neural
-                    .iter()
-                    .copied()
-                    .map(|k| {
-                        (k, RunOptions { parametrization: AngleParametrization::ViewLight, ..d })
-                    })
-                    .collect(),
-                Ablation::Nerfactor => additive
-                    .iter()
-                    .flat_map(|&k| {
-                        [
-                            RunOptions { albedo_clamp: true, ..d },
-                            RunOptions { scalar_specular: true, ..d },
-                        ]
-                        .map(|o| (k, o))
-                    })
-                    .collect(),
-            };
+            let variants = ablation_variants(ablation, &neural, &additive);
             for (kind, o) in variants {
                 // The ablation's baseline is the Table 1 run of the same model.
                 push(scene, Purpose::Table, with_options(table_base, kind, d)?);
@@ -217,6 +188,39 @@ pub fn runs(profile: &SweepProfile) -> Result<Vec<RunSpec>> {
         }
     }
     Ok(out)
+}
+
+/// The runs of one ablation: its variants of the purely neural models `neural` (NeRFactor's of
+/// the additive ones among them, `additive`).
+fn ablation_variants(
+    ablation: Ablation,
+    neural: &[ModelKind],
+    additive: &[ModelKind],
+) -> Vec<(ModelKind, RunOptions)> {
+    let d = RunOptions::DEFAULT;
+    match ablation {
+        Ablation::Nol => neural.iter().map(|&k| (k, RunOptions { nol: true, ..d })).collect(),
+        Ablation::Reciprocity => neural
+            .iter()
+            .copied()
+            .flat_map(|k| {
+                [Reciprocity::RandomSwap, Reciprocity::Mapping]
+                    .map(|r| (k, RunOptions { reciprocity: r, ..d }))
+            })
+            .collect(),
+        Ablation::Angles => neural
+            .iter()
+            .copied()
+            .map(|k| (k, RunOptions { parametrization: AngleParametrization::ViewLight, ..d }))
+            .collect(),
+        Ablation::Nerfactor => additive
+            .iter()
+            .flat_map(|&k| {
+                [RunOptions { albedo_clamp: true, ..d }, RunOptions { scalar_specular: true, ..d }]
+                    .map(|o| (k, o))
+            })
+            .collect(),
+    }
 }
 
 /// The content address of a run on a scene whose manifest checksum is `scene_checksum`.

@@ -136,21 +136,7 @@ pub fn write(
     let kind = material.kind;
     let uniform = material.is_uniform();
     let row = material.uniform_or_mean();
-    // (name, component count, bytes) of every vertex attribute.
-    let mut attributes: Vec<(String, usize, Vec<u8>)> = vec![
-        ("POSITION".into(), 3, f32_bytes(mesh.positions.iter().flatten().copied())),
-        ("NORMAL".into(), 3, f32_bytes(mesh.normals.iter().flatten().copied())),
-    ];
-    if !uniform {
-        let colour = colour_columns(kind).map(|c| material.column(c));
-        let rgb = (0..n).flat_map(|i| [colour[0][i], colour[1][i], colour[2][i]]);
-        attributes.push(("COLOR_0".into(), 3, f32_bytes(rgb)));
-        for &c in kind.columns() {
-            if !colour_columns(kind).contains(&c) {
-                attributes.push((attribute_name(c), 1, f32_bytes(material.column(c))));
-            }
-        }
-    }
+    let attributes = vertex_attributes(mesh, material);
     let mut bin = Vec::new();
     let (mut views, mut accessors, mut attr_json) = (vec![], vec![], serde_json::Map::new());
     for (i, (attr, comps, bytes)) in attributes.iter().enumerate() {
@@ -179,18 +165,7 @@ pub fn write(
     accessors.push(json!({"bufferView": views.len() - 1, "componentType": UNSIGNED_INT,
                           "count": mesh.triangles.len() * 3, "type": "SCALAR"}));
     bin.extend_from_slice(&indices);
-    let mut mat = material_json(kind, &row, !uniform);
-    let model = match kind {
-        MaterialKind::Disney => "disney",
-        MaterialKind::TorranceSparrow => "torrance_sparrow",
-    };
-    let mut extras = json!({"model": model, "columns": kind.columns(), "uniform": uniform});
-    if uniform {
-        extras["values"] = json!(row);
-    } else {
-        extras["mean"] = json!(row);
-    }
-    mat["extras"] = json!({ EXTRAS_KEY: extras });
+    let mat = material_with_extras(kind, &row, uniform);
     let mut used = vec!["KHR_materials_specular"];
     if kind == MaterialKind::Disney {
         used.push("KHR_materials_clearcoat");
@@ -212,6 +187,48 @@ pub fn write(
     let text = serde_json::to_vec_pretty(&doc).map_err(|e| Error::format(dir, e.to_string()))?;
     stdx::fs::write_atomic(&dir.join(format!("{name}.gltf")), &text)?;
     Ok(())
+}
+
+/// (name, component count, bytes) of every vertex attribute: positions, normals and, for a
+/// spatially varying material, its colour and every other parameter column.
+fn vertex_attributes(
+    mesh: &ExportMesh<'_>,
+    material: &ExportedMaterial,
+) -> Vec<(String, usize, Vec<u8>)> {
+    let (n, kind) = (mesh.positions.len(), material.kind);
+    let mut attributes: Vec<(String, usize, Vec<u8>)> = vec![
+        ("POSITION".into(), 3, f32_bytes(mesh.positions.iter().flatten().copied())),
+        ("NORMAL".into(), 3, f32_bytes(mesh.normals.iter().flatten().copied())),
+    ];
+    if !material.is_uniform() {
+        let colour = colour_columns(kind).map(|c| material.column(c));
+        let rgb = (0..n).flat_map(|i| [colour[0][i], colour[1][i], colour[2][i]]);
+        attributes.push(("COLOR_0".into(), 3, f32_bytes(rgb)));
+        for &c in kind.columns() {
+            if !colour_columns(kind).contains(&c) {
+                attributes.push((attribute_name(c), 1, f32_bytes(material.column(c))));
+            }
+        }
+    }
+    attributes
+}
+
+/// The glTF material of `row` with this crate's exact values in its `extras` (the uniform row,
+/// or the mean of a varying one).
+fn material_with_extras(kind: MaterialKind, row: &[f32], uniform: bool) -> serde_json::Value {
+    let mut mat = material_json(kind, row, !uniform);
+    let model = match kind {
+        MaterialKind::Disney => "disney",
+        MaterialKind::TorranceSparrow => "torrance_sparrow",
+    };
+    let mut extras = json!({"model": model, "columns": kind.columns(), "uniform": uniform});
+    if uniform {
+        extras["values"] = json!(row);
+    } else {
+        extras["mean"] = json!(row);
+    }
+    mat["extras"] = json!({ EXTRAS_KEY: extras });
+    mat
 }
 
 /// Reads the exact per-vertex parameters back from an asset [`write`](fn@write) made, with the `gltf`

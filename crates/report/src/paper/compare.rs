@@ -81,39 +81,10 @@ pub fn beside(
             paper.metrics(&d).into_iter().map(move |m| (d.clone(), mine.clone(), m))
         })
         .collect();
+    let several = paper.datasets().len() > 1;
     let groups = columns
         .iter()
-        .map(|(d, mine, m)| {
-            // The data set goes into the group title only where the table has several.
-            let on = match (paper.datasets().len(), d == mine) {
-                (1, _) => String::new(),
-                (_, true) => format!(", {}", d.label()),
-                (_, false) => format!(", ours {}, paper {}", mine.label(), d.label()),
-            };
-            let first = match measure {
-                Measure::Level => Column::metric(*m),
-                Measure::Delta => Column::delta(*m),
-            };
-            let neutral = |c: Column| Column { direction: Direction::Neutral, ..c };
-            let compared = match against {
-                Against::Difference => neutral(Column::delta(*m).labelled("ours − paper")),
-                Against::Ratio => Column {
-                    factor: 1.0,
-                    decimals: 2,
-                    signed: false,
-                    ..neutral(Column::metric(*m).labelled("ours / paper"))
-                },
-            };
-            ColumnGroup {
-                title: format!("{}{on}", m.label()),
-                columns: vec![
-                    first.clone().labelled("ours"),
-                    neutral(Column { signed: false, ..first.clone() }.labelled("± (objects)")),
-                    first.labelled("paper"),
-                    compared,
-                ],
-            }
-        })
+        .map(|(d, mine, m)| column_group(several, (d, mine), *m, measure, against))
         .collect();
     let rows_of = paper.rows();
     let has_variants = rows_of.iter().any(|r| r.1 != RunOptions::DEFAULT);
@@ -171,6 +142,45 @@ pub fn beside(
         rows,
         marking: Marking::None,
         notes: vec![],
+    }
+}
+
+/// The column group of one printed column: ours, our spread, the paper's and the comparison;
+/// the data set in its title only where the table has `several`.
+fn column_group(
+    several: bool,
+    (d, mine): (&Dataset, &Dataset),
+    m: MetricKind,
+    measure: Measure,
+    against: Against,
+) -> ColumnGroup {
+    let on = match (several, d == mine) {
+        (false, _) => String::new(),
+        (_, true) => format!(", {}", d.label()),
+        (_, false) => format!(", ours {}, paper {}", mine.label(), d.label()),
+    };
+    let first = match measure {
+        Measure::Level => Column::metric(m),
+        Measure::Delta => Column::delta(m),
+    };
+    let neutral = |c: Column| Column { direction: Direction::Neutral, ..c };
+    let compared = match against {
+        Against::Difference => neutral(Column::delta(m).labelled("ours − paper")),
+        Against::Ratio => Column {
+            factor: 1.0,
+            decimals: 2,
+            signed: false,
+            ..neutral(Column::metric(m).labelled("ours / paper"))
+        },
+    };
+    ColumnGroup {
+        title: format!("{}{on}", m.label()),
+        columns: vec![
+            first.clone().labelled("ours"),
+            neutral(Column { signed: false, ..first.clone() }.labelled("± (objects)")),
+            first.labelled("paper"),
+            compared,
+        ],
     }
 }
 

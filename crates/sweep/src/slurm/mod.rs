@@ -161,36 +161,7 @@ pub fn submit(
     first: Option<(&str, &str, &str)>,
     options: &SlurmOptions,
 ) -> Result<Submission> {
-    let recorded = SlurmSweep::path(out).exists();
-    let mut sweep = match SlurmSweep::read(out) {
-        // A record that cannot be read is not replaced: its job ids would be lost.
-        Err(e) if recorded => return Err(e),
-        Ok(mut s) => {
-            if !all.is_empty() {
-                s.runs = absolute_all(all)?;
-            }
-            if first.is_some() {
-                s.options = options.clone();
-            }
-            s
-        }
-        Err(_) => {
-            let (profile, program, backend) = first.ok_or_else(|| {
-                Error::format(SlurmSweep::path(out), "no submission recorded to resubmit")
-            })?;
-            SlurmSweep {
-                profile: profile.into(),
-                program: program.into(),
-                backend: backend.into(),
-                runs: absolute_all(all)?,
-                options: options.clone(),
-                submissions: Vec::new(),
-            }
-        }
-    };
-    if let Some((_, program, backend)) = first {
-        (sweep.program, sweep.backend) = (program.into(), backend.into());
-    }
+    let mut sweep = sweep_record(out, all, first, options)?;
     let number = sweep.submissions.iter().map(|s| s.number).max().unwrap_or(0) + 1;
     let layout = SweepLayout::new(out);
     let dir = layout.slurm().join(format!("submit-{number:03}"));
@@ -221,16 +192,8 @@ pub fn submit(
                 k + 1,
                 if runs.len() > max { format!("-{}", c + 1) } else { String::new() }
             );
-            let models = models_of(chunk);
-            let tasks = dir.join(format!("tasks-{id}.txt"));
-            let mut list = String::new();
-            for r in chunk {
-                list.push_str(
-                    &std::path::absolute(r).map_err(|e| Error::io(r, e))?.display().to_string(),
-                );
-                list.push('\n');
-            }
-            stdx::fs::write_atomic(&tasks, list.as_bytes())?;
+            let (models, tasks) = (models_of(chunk), dir.join(format!("tasks-{id}.txt")));
+            write_task_list(&tasks, chunk)?;
             let label = match models.as_slice() {
                 [one] => one.clone(),
                 [first, rest @ ..] => format!("{first}-and-{}-more", rest.len()),
@@ -268,6 +231,58 @@ pub fn submit(
     sweep.submissions.push(submission.clone());
     sweep.write(out)?;
     Ok(submission)
+}
+
+/// The sweep's record with this submission's runs and options: the one on disk (an unreadable
+/// one is an error, not replaced: its job ids would be lost), or a new one for a first
+/// submission (`first`: profile, program, backend).
+fn sweep_record(
+    out: &Path,
+    all: &[PathBuf],
+    first: Option<(&str, &str, &str)>,
+    options: &SlurmOptions,
+) -> Result<SlurmSweep> {
+    let recorded = SlurmSweep::path(out).exists();
+    let mut sweep = match SlurmSweep::read(out) {
+        // A record that cannot be read is not replaced: its job ids would be lost.
+        Err(e) if recorded => return Err(e),
+        Ok(mut s) => {
+            if !all.is_empty() {
+                s.runs = absolute_all(all)?;
+            }
+            if first.is_some() {
+                s.options = options.clone();
+            }
+            s
+        }
+        Err(_) => {
+            let (profile, program, backend) = first.ok_or_else(|| {
+                Error::format(SlurmSweep::path(out), "no submission recorded to resubmit")
+            })?;
+            SlurmSweep {
+                profile: profile.into(),
+                program: program.into(),
+                backend: backend.into(),
+                runs: absolute_all(all)?,
+                options: options.clone(),
+                submissions: Vec::new(),
+            }
+        }
+    };
+    if let Some((_, program, backend)) = first {
+        (sweep.program, sweep.backend) = (program.into(), backend.into());
+    }
+    Ok(sweep)
+}
+
+/// Writes the absolute paths of `runs`, one a line: task i runs line i + 1.
+fn write_task_list(tasks: &Path, runs: &[PathBuf]) -> Result<()> {
+    let mut list = String::new();
+    for r in runs {
+        list.push_str(&std::path::absolute(r).map_err(|e| Error::io(r, e))?.display().to_string());
+        list.push('\n');
+    }
+    Ok(stdx::fs::write_atomic(tasks, list.as_bytes())?)
 }
 
 fn absolute_all(runs: &[PathBuf]) -> Result<Vec<PathBuf>> {
