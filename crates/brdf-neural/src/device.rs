@@ -65,7 +65,7 @@ pub fn on_gpu<const D: usize>(x: &burn::tensor::Tensor<D>) -> bool {
 /// What this build does with a [`Backend`]: whether it is built in, and its devices.
 pub trait BackendDevice {
     /// Whether this backend's cargo feature is on in this build.
-    fn is_built(self) -> bool;
+    fn is_built(&self) -> bool;
     /// The inference device of this backend, or an error if it was not compiled in.
     fn device(self) -> crate::Result<Device>;
     /// The training device of this backend (the inference device with autodiff).
@@ -73,8 +73,8 @@ pub trait BackendDevice {
 }
 
 impl BackendDevice for Backend {
-    fn is_built(self) -> bool {
-        match self {
+    fn is_built(&self) -> bool {
+        match *self {
             Backend::Flex => cfg!(feature = "flex"),
             Backend::NdArray => cfg!(feature = "ndarray"),
             Backend::Wgpu => cfg!(feature = "wgpu"),

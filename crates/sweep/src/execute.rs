@@ -331,7 +331,7 @@ fn run_in_process(
     for d in todo {
         bar.set_message(short(d));
         lines.started(d);
-        match bar.suspend(|| run_one(d, true, *backend)) {
+        match bar.suspend(|| run_one(d, true, backend)) {
             Ok(RunEnd::Interrupted(_)) => {
                 summary.failed.push(((*d).clone(), "interrupted by a signal".into()));
                 lines.finished(d, false);
