@@ -118,7 +118,7 @@ pub fn run(out: &Path, root: &Path) -> Result<()> {
     let runs = out.join("runs");
     let mut versions: Vec<String> = Vec::new();
     for entry in std::fs::read_dir(&runs).with_context(|| format!("reading {}", runs.display()))? {
-        let info = entry?.path().join("run.json");
+        let info = run_format::run_dir::RunDir::new(entry?.path()).info();
         let Ok(text) = std::fs::read_to_string(&info) else { continue };
         let v: serde_json::Value =
             serde_json::from_str(&text).with_context(|| format!("parsing {}", info.display()))?;

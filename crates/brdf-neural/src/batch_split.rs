@@ -63,7 +63,7 @@ impl Drop for BatchSplitGuard {
 
 /// `layer` applied to `x` (`[rows, d_in]` to `[rows, d_out]`), split as the thread's
 /// [`scope`] says; unsplit, through [`crate::linear_op::linear`] in the thread's
-/// [`PrecisionScope::current`](crate::precision::PrecisionScope::current)(crate::precision::MatmulPrecision::current).
+/// [`PrecisionScope::current`](crate::precision::MatmulPrecision::current).
 pub(crate) fn linear(layer: &Linear, x: Tensor<2>) -> Tensor<2> {
     let parts = parts();
     let [rows, d_in] = x.dims();

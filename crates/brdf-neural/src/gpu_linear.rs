@@ -6,7 +6,7 @@
 //! | `burn` | burn's: CubeCL's autotuned matrix product; the trainer splits the batch ([`crate::batch_split`]) so that autodiff splits the weight gradients |
 //!
 //! The choice is per process (the environment is read once). An unknown value is refused when a
-//! GPU device is made ([`crate::device::Backend::device`]), naming the variable. `ours` is the
+//! GPU device is made ([`crate::device::BackendDevice::device`]), naming the variable. `ours` is the
 //! default since it was measured on an H200 (2026-11-28, `benches/README.md`): as fast as burn's
 //! kernels once burn's autotune has settled (Single MLP step 4.6 against 4.5 ms at 2^15, Disney
 //! 8.6 to 9.0 against 8.7), three times faster in a first process, before the autotune cache

@@ -10,11 +10,11 @@
 //! tensor cores (`gpu-kernels`' `gemm_cmma`), PyTorch's bf16 autocast for the linear layers.
 //! The flex and cuda backends implement it; the others refuse it.
 //!
-//! The setting belongs to the training loop of one thread: [`PrecisionScope::scope`](crate::precision::PrecisionScope::scope) applies
+//! The setting belongs to the training loop of one thread: [`PrecisionScope::scope`] applies
 //! it to the linear layers of the models that thread runs until the returned guard drops, so an
-//! evaluation on another thread (or after the fit) keeps f32; [`PrecisionScope::f32_scope`](crate::precision::PrecisionScope::f32_scope)
+//! evaluation on another thread (or after the fit) keeps f32; [`PrecisionScope::f32_scope`]
 //! returns to f32 inside a bf16 scope (the training loop's validation loss, which decides the
-//! plateau schedule, is f32). The layers read it when they run ([`PrecisionScope::current`](crate::precision::PrecisionScope::current))
+//! plateau schedule, is f32). The layers read it when they run ([`PrecisionScope::current`])
 //! and hand it to the kernels as an argument of each product ([`crate::linear_op`]), which keep
 //! it for the product's backward pass; no other matrix product in the process is affected.
 //! Products that gain nothing (narrow heads such as the 3-channel output, small products) stay
@@ -46,12 +46,12 @@ pub trait PrecisionScope {
     fn f32_scope() -> PrecisionGuard;
 
     /// The precision of the linear layers the calling thread runs now (f32 outside a
-    /// [`PrecisionScope::scope`](crate::precision::PrecisionScope::scope)).
+    /// [`PrecisionScope::scope`]).
     fn current() -> MatmulPrecision;
 
     /// Whether this CPU has Intel's AMX-BF16 tile unit (Xeons from Sapphire Rapids on; CPUID
     /// leaf 7, EDX bit 22). The flex backend's bf16 products run on it when Linux grants the
-    /// tile registers ([`PrecisionScope::bf16_on_amx`](crate::precision::PrecisionScope::bf16_on_amx)); without it they take the AVX512-BF16
+    /// tile registers ([`PrecisionScope::bf16_on_amx`]); without it they take the AVX512-BF16
     /// kernel, measured slower than f32 on such a Xeon (`benches/README.md`, "bf16 on an Intel
     /// Xeon with AMX"), and the trainer warns.
     fn cpu_has_amx_bf16() -> bool;

@@ -12,7 +12,7 @@
 //!   views x 12 lights split).
 //!
 //! Modules:
-//! * [`capture`]: one capture directory (16-bit PNGs, light files, mask) with its checks and
+//! * [`pms_dir`]: one capture directory (16-bit PNGs, light files, mask) with its checks and
 //!   DiLiGenT's camera axes.
 //! * [`calibration`]: DiLiGenT-MV's `Calib_Results.mat` cameras (non-orthonormal rotations
 //!   factored into the intrinsics).

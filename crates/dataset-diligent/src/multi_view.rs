@@ -12,7 +12,7 @@
 //! Cameras: see [`crate::calibration`] (x_c = Rc x_w + Tc; the principal point gets
 //! [`MultiViewOptions::principal_point_offset`]; non-orthonormal Rc are factored exactly into
 //! the intrinsics). Light directions are in each view's camera frame (DiLiGenT's axes, see
-//! [`crate::capture`]) and go to the world as R^T (x, -y, -z). When a view ships its
+//! [`crate::pms_dir`]) and go to the world as R^T (x, -y, -z). When a view ships its
 //! `Normal_gt.mat`, the mesh's normals are compared with it ([`crate::normal_check`]).
 //!
 //! The mesh is cleaned, decimated to [`MultiViewOptions::target_vertices`] (quadric error, see

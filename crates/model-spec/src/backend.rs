@@ -36,7 +36,7 @@ impl Backend {
         matches!(self, Backend::Wgpu | Backend::Cuda)
     }
 
-    /// The name [`Backend::parse`] reads (and `metrics.json` records).
+    /// The name [`Backend::parse_with`] reads (and `metrics.json` records).
     pub fn name(self) -> &'static str {
         match self {
             Backend::Flex => "flex",

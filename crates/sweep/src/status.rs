@@ -190,7 +190,7 @@ pub fn runs_under(out: &Path) -> std::io::Result<Vec<PathBuf>> {
     let mut runs = Vec::new();
     for entry in std::fs::read_dir(&root)? {
         let path = entry?.path();
-        if path.join("config.toml").is_file() {
+        if run_format::run_dir::RunDir::new(&path).config().is_file() {
             runs.push(path);
         }
     }
