@@ -42,7 +42,8 @@ use brdf_neural::device::Backend;
 use brdf_neural::device::BackendDevice;
 use brdf_neural::mlp::MlpConfig;
 use brdf_neural::precision::MatmulPrecision;
-use brdf_neural::precision::PrecisionScope;
+use brdf_neural::precision::PrecisionSupport;
+use brdf_neural::products::Products;
 use brdf_neural::{BrdfBatch, BrdfModel, ModelConfig, ModelKind, Reciprocity, Samples};
 use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
 use burn::tensor::{Device, Distribution, Tensor};
@@ -101,10 +102,6 @@ struct Step {
     weight: Tensor<2>,
     target: Tensor<2>,
     device: Device,
-    backend: Backend,
-    precision: MatmulPrecision,
-    /// Parts the linear layers' batch is split into ([`batch_split`]).
-    split: usize,
 }
 
 impl Step {
@@ -132,8 +129,10 @@ impl Step {
         let l: Vec<_> = (0..n).map(|_| dir()).collect();
         let v: Vec<_> = (0..n).map(|_| dir()).collect();
         let spatial: Vec<f32> = (0..n * c.spatial_dim).map(|_| 2.0 * uniform() - 1.0).collect();
+        precision.check(backend).expect("precision on this backend");
         let batch =
             BrdfBatch::new(c, &Samples { spatial: &spatial, l: &l, v: &v }, None, device).unwrap();
+        let batch = batch.with_products(Products { precision, parts: split });
         let weight = Tensor::random([n, 1], Distribution::Uniform(0.0, 3.0), device);
         let target = Tensor::random([n, 3], Distribution::Uniform(0.0, 1.0), device);
         Self {
@@ -143,16 +142,11 @@ impl Step {
             weight,
             target,
             device: device.clone(),
-            backend,
-            precision,
-            split,
         }
     }
 
     /// Forward, radiance L = f * (E shadow cos), MSE, backward, Adam; waits for the device.
     fn run(&mut self) {
-        let _precision = self.precision.scope(self.backend).expect("precision on this backend");
-        let _split = batch_split::scope(self.split);
         let model = self.model.take().expect("model");
         let out = model.forward(&self.batch);
         let loss = (out.f * self.weight.clone() - self.target.clone()).square().mean();
@@ -484,7 +478,7 @@ fn backends_and_precisions(n: usize) -> Vec<(Backend, MatmulPrecision, usize)> {
     let mut out = Vec::new();
     for b in backends() {
         for p in precisions() {
-            if p.scope(b).is_ok() {
+            if p.check(b).is_ok() {
                 out.extend(splits(b, n).into_iter().map(|s| (b, p, s)));
             }
         }
@@ -588,21 +582,19 @@ fn flex_product_rates(n: usize) -> [(f64, f64); 3] {
     let dy: Tensor<2> = Tensor::random([n, 128], Distribution::Uniform(-1.0, 1.0), &device);
     let w: Tensor<2> = Tensor::random([128, 128], Distribution::Uniform(-1.0, 1.0), &device);
     let flops = 2.0 * (n * 128 * 128) as f64;
-    let rate = |p: MatmulPrecision, f: &dyn Fn() -> Tensor<2>| {
-        let _g = p.scope(Backend::Flex).expect("flex");
+    let rate = |p: MatmulPrecision, (a, b): (&Tensor<2>, &Tensor<2>)| {
+        p.check(Backend::Flex).expect("flex");
         let mut best = f64::INFINITY;
         for _ in 0..11 {
             let t = Instant::now();
-            std::hint::black_box(f());
+            std::hint::black_box(brdf_neural::linear_op::linear(a.clone(), b.clone(), None, p));
             best = best.min(t.elapsed().as_secs_f64());
         }
         flops / best / 1e9
     };
-    let products: [&dyn Fn() -> Tensor<2>; 3] =
-        [&|| x.clone().matmul(w.clone()), &|| x.clone().transpose().matmul(dy.clone()), &|| {
-            dy.clone().matmul(w.clone().transpose())
-        }];
-    products.map(|f| (rate(MatmulPrecision::F32, f), rate(MatmulPrecision::Bf16, f)))
+    let (xt, wt) = (x.clone().transpose(), w.clone().transpose());
+    let products = [(&x, &w), (&xt, &dy), (&dy, &wt)];
+    products.map(|ab| (rate(MatmulPrecision::F32, ab), rate(MatmulPrecision::Bf16, ab)))
 }
 
 fn rayon_threads() -> usize {

@@ -9,6 +9,7 @@
 
 use crate::mlp::Mlp;
 use crate::output::{AdditiveHead, BrdfOutput};
+use crate::products::Products;
 use burn::module::Module;
 use burn::tensor::Tensor;
 
@@ -38,9 +39,9 @@ impl AdditiveSeparate {
     /// # Shapes
     /// - spatial: `[batch, spatial_dim]`; angles: `[batch, angle_dim]`
     /// - output: `f`, `diffuse`, `specular` (and `xi` when enhanced) `[batch, 3]`
-    pub fn forward(&self, spatial: Tensor<2>, angles: Tensor<2>) -> BrdfOutput {
-        let d = self.diffuse.forward(spatial.clone(), None);
-        let s = self.specular.forward(spatial, Some(angles));
+    pub fn forward(&self, spatial: Tensor<2>, angles: Tensor<2>, products: Products) -> BrdfOutput {
+        let d = self.diffuse.forward(spatial.clone(), None, products);
+        let s = self.specular.forward(spatial, Some(angles), products);
         self.head.combine(d, s)
     }
 }

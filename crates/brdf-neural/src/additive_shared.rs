@@ -9,6 +9,7 @@
 
 use crate::mlp::Mlp;
 use crate::output::{AdditiveHead, BrdfOutput};
+use crate::products::Products;
 use burn::module::Module;
 use burn::tensor::Tensor;
 
@@ -40,10 +41,10 @@ impl AdditiveShared {
     /// # Shapes
     /// - spatial: `[batch, spatial_dim]`; angles: `[batch, angle_dim]`
     /// - output: `f`, `diffuse`, `specular` (and `xi` when enhanced) `[batch, 3]`
-    pub fn forward(&self, spatial: Tensor<2>, angles: Tensor<2>) -> BrdfOutput {
-        let feature = self.trunk.forward(spatial, None);
-        let d = self.diffuse.forward(feature.clone(), None);
-        let s = self.specular.forward(feature, Some(angles));
+    pub fn forward(&self, spatial: Tensor<2>, angles: Tensor<2>, products: Products) -> BrdfOutput {
+        let feature = self.trunk.forward(spatial, None, products);
+        let d = self.diffuse.forward(feature.clone(), None, products);
+        let s = self.specular.forward(feature, Some(angles), products);
         self.head.combine(d, s)
     }
 }

@@ -14,6 +14,7 @@
 //! ([`BrdfBatch::from_table`]): the same values as gathering them on the CPU and uploading
 //! them with every batch ([`BrdfBatch::from_owned`]), without the copy and the transfer.
 
+use crate::products::Products;
 use crate::tensor_brdf::Geometry;
 use crate::{Error, ModelConfig, ModelKind, Result};
 use burn::tensor::{Device, Int, Tensor, TensorData};
@@ -41,6 +42,9 @@ pub struct BrdfBatch {
     pub angles: Option<Tensor<2>>,
     /// Direction-only BRDF terms (parametric models).
     pub geometry: Option<Geometry>,
+    /// How the model's linear layers compute their products on this batch: plain f32 unless
+    /// set ([`BrdfBatch::with_products`]; a training step's batches carry the run's).
+    pub products: Products,
 }
 
 /// The spatial feature rows of a set of surface points on the device, sanitised, for
@@ -194,7 +198,12 @@ impl BrdfBatch {
         });
         let geometry = (!config.uses_angle_features())
             .then(|| Geometry::new(l, v, config.kind == ModelKind::Fmbrdf, device));
-        Ok(BrdfBatch { spatial, angles, geometry })
+        Ok(BrdfBatch { spatial, angles, geometry, products: Products::F32 })
+    }
+
+    /// The same batch, its linear layers' products computed as `products` says.
+    pub fn with_products(self, products: Products) -> BrdfBatch {
+        BrdfBatch { products, ..self }
     }
 }
 

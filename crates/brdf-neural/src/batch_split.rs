@@ -4,43 +4,28 @@
 //! hidden layer) whose every element is a sum over the whole batch (32,768 rows at the paper's
 //! budget). A matrix-product kernel without split-K (CubeCL's, as of 0.11) parallelizes over the
 //! output only: 16,384 sums, each walking all 32,768 rows, too little parallel work for a large
-//! GPU. Measured on an H200 (benches/README.md): 0.788 ms for that product, 0.292 ms split into
-//! 64 parts and summed.
+//! GPU; split into 64 parts and summed, the product ran several times faster on an H200
+//! (`benches/README.md`).
 //!
-//! Inside a [`scope`] of `parts > 1`, the network's linear layers compute `y = X W + b` as a
-//! batched product over `parts` blocks of rows, `y_p = X_p W + b`, with `W` broadcast: the
+//! For a batch whose [`Products::parts`] exceeds 1, the network's linear layers compute
+//! `y = X W + b` as a batched product over `parts` blocks of rows, `y_p = X_p W + b`, with `W`
+//! broadcast: the
 //! forward value is the same product (backends fold a broadcast right operand into one
 //! product), and burn's autodiff turns the broadcast into `parts` independent products
 //! `X_pᵀ G_p` and one sum over the parts, the split-K schedule that cuBLAS picks for such shapes.
 //! Only the summation order of the weight gradients changes. Batches that `parts` does not
 //! divide, or with fewer than [`MIN_ROWS`] rows a part, keep the plain product.
 //!
-//! The setting is per thread, like [`crate::precision`]; the default (1 part) is the plain
-//! product, which keeps the CPU fits bit-identical to before. The experiments trainer turns it
-//! on for GPU backends ([`gpu_parts`]).
+//! The split is part of the batch's [`Products`], like the precision; the default (1 part)
+//! is the plain product, which keeps the CPU fits bit-identical to before. A training loop on
+//! a GPU asks for [`gpu_parts`] ([`Products::training`]).
 
-use crate::precision::PrecisionScope;
+use crate::products::Products;
 use burn::nn::Linear;
 use burn::tensor::Tensor;
-use std::cell::Cell;
 
 /// The fewest rows a part may have; smaller parts would make the sum over the parts the cost.
 pub const MIN_ROWS: usize = 256;
-
-thread_local! {
-    static PARTS: Cell<usize> = const { Cell::new(1) };
-}
-
-/// Computes the linear layers the calling thread runs with their batch split into `parts`
-/// (1: the plain product) until the returned guard drops.
-pub fn scope(parts: usize) -> BatchSplitGuard {
-    BatchSplitGuard { previous: PARTS.with(|p| p.replace(parts.max(1))) }
-}
-
-/// The number of parts in effect on the calling thread.
-pub fn parts() -> usize {
-    PARTS.with(Cell::get)
-}
 
 /// The split a GPU training loop uses for a batch of `rows`: parts of 512 rows (64 parts at
 /// 2^15), at most 64 parts, and 1 where that does not divide the batch.
@@ -49,23 +34,11 @@ pub fn gpu_parts(rows: usize) -> usize {
     if rows.is_multiple_of(parts) { parts } else { 1 }
 }
 
-/// Restores the thread's previous split when dropped.
-#[must_use = "the split applies only while the guard lives"]
-pub struct BatchSplitGuard {
-    previous: usize,
-}
-
-impl Drop for BatchSplitGuard {
-    fn drop(&mut self) {
-        PARTS.with(|p| p.set(self.previous));
-    }
-}
-
-/// `layer` applied to `x` (`[rows, d_in]` to `[rows, d_out]`), split as the thread's
-/// [`scope`] says; unsplit, through [`crate::linear_op::linear`] in the thread's
-/// [`PrecisionScope::current`](crate::precision::MatmulPrecision::current).
-pub(crate) fn linear(layer: &Linear, x: Tensor<2>) -> Tensor<2> {
-    let parts = parts();
+/// `layer` applied to `x` (`[rows, d_in]` to `[rows, d_out]`), split into
+/// [`Products::parts`]; unsplit, through [`crate::linear_op::linear`] in
+/// [`Products::precision`].
+pub(crate) fn linear(layer: &Linear, x: Tensor<2>, products: Products) -> Tensor<2> {
+    let parts = products.parts;
     let [rows, d_in] = x.dims();
     // The gpu-kernels split the weight gradients inside their own kernel.
     let own_kernels = crate::linear_op::uses_gpu_kernels(&x);
@@ -74,8 +47,7 @@ pub(crate) fn linear(layer: &Linear, x: Tensor<2>) -> Tensor<2> {
         // `val()`, in the order burn's `Linear::forward` reads them.
         let weight = layer.weight.val();
         let bias = layer.bias.as_ref().map(|b| b.val());
-        let precision = crate::precision::MatmulPrecision::current();
-        return crate::linear_op::linear(x, weight, bias, precision);
+        return crate::linear_op::linear(x, weight, bias, products.precision);
     }
     let weight = layer.weight.val();
     let d_out = weight.dims()[1];
@@ -106,28 +78,13 @@ mod tests {
     }
 
     #[test]
-    fn the_scope_sets_and_restores_the_split() {
-        assert_eq!(parts(), 1);
-        {
-            let _outer = scope(8);
-            assert_eq!(parts(), 8);
-            {
-                let _inner = scope(0);
-                assert_eq!(parts(), 1);
-            }
-            assert_eq!(parts(), 8);
-        }
-        assert_eq!(parts(), 1);
-    }
-
-    #[test]
     fn split_layers_give_the_plain_values_and_gradients() {
         let device = crate::device::cpu().autodiff();
         let layer = LinearConfig::new(5, 3).init(&device);
         let x = Tensor::<2>::random([1_024, 5], Distribution::Normal(0.0, 1.0), &device);
         let run = |parts: usize| {
-            let _split = scope(parts);
-            let y = linear(&layer, x.clone());
+            let products = Products { parts, ..Products::F32 };
+            let y = linear(&layer, x.clone(), products);
             let grads = (y.clone() * y.clone()).sum().backward();
             let gw = layer.weight.val().grad(&grads).expect("weight gradient");
             let gb = layer.bias.as_ref().unwrap().val().grad(&grads).expect("bias gradient");

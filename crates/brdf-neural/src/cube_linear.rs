@@ -7,8 +7,8 @@
 //! kernels' grid limits, takes burn's own operations instead, so every input has an answer.
 //! A layer's products run in the precision the layer hands over: f32, or
 //! [`MatmulPrecision::Bf16`] on tensor cores (`gpu_kernels::gemm_cmma`; CUDA on Ampere or
-//! later; [`PrecisionScope::scope`](crate::precision::PrecisionScope::scope) refuses bf16 on wgpu, whose WGSL has no such
-//! instructions). A CUDA device without them runs the products in f32, and says so once.
+//! later; [`PrecisionSupport::check`](crate::precision::PrecisionSupport::check) refuses bf16
+//! on wgpu, whose WGSL has no such instructions). A CUDA device without them runs the products in f32, and says so once.
 
 use crate::linear_op::LinearKernels;
 use crate::precision::MatmulPrecision;

@@ -19,7 +19,7 @@
 //! user and machine ([`crate::gpu_cache`]), so only the first process on a machine tunes.
 //!
 //! The CPU devices made here also tell the C allocator to keep freed tensor buffers for reuse
-//! ([`crate::host_memory`]): 1.5 to 1.7x faster training steps on glibc, measured.
+//! ([`crate::host_memory`]): markedly faster training steps on glibc (`benches/README.md`).
 //!
 //! No build requires a CPU feature the machine may lack: flex's matrix products come from the
 //! `gemm` crate, which picks AVX2/FMA kernels at run time; its AVX-512 kernels are compiled only

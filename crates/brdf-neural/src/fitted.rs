@@ -8,10 +8,8 @@
 //! uploads only indices and directions. Training keeps its records there too
 //! ([`device_records`]).
 
-use crate::{
-    BrdfBatch, BrdfModel, Error, ModelConfig, RecordTable, Result, Samples, SpatialTable,
-    batch_split,
-};
+use crate::products::Products;
+use crate::{BrdfBatch, BrdfModel, Error, ModelConfig, RecordTable, Result, Samples, SpatialTable};
 use burn::tensor::{Device, Tensor, TensorData};
 
 /// Spatial rows of surface points, row-major `[points, dim]`, and the point of each record.
@@ -122,9 +120,6 @@ pub fn forward_rows(
 ) -> Result<Prediction> {
     let gpu = !crate::device::is_cpu_device(device);
     let rows = pass_rows(samples.l.len(), gpu);
-    // On a GPU, the training loop's parts of 512 rows (`batch_split::gpu_parts`): every pass of
-    // an evaluation then meets the matrix-product shapes that training tuned.
-    let _split = gpu.then(|| batch_split::scope(batch_split::gpu_parts(rows)));
     forward_padded(model, config, Spatial::Rows, samples, device, parts, rows)
 }
 
@@ -144,7 +139,6 @@ pub fn forward_points(
 ) -> Result<Prediction> {
     let gpu = !crate::device::is_cpu_device(device);
     let rows = pass_rows(l.len(), gpu);
-    let _split = gpu.then(|| batch_split::scope(batch_split::gpu_parts(rows)));
     let samples = Samples { spatial: &[], l, v };
     forward_padded(model, config, Spatial::Table(table, points), &samples, device, parts, rows)
 }
@@ -178,6 +172,9 @@ fn forward_padded(
     } else {
         (padded(samples.l).into(), padded(samples.v).into())
     };
+    // On a GPU, the training loop's parts of 512 rows (`batch_split::gpu_parts`): every pass of
+    // an evaluation then meets the matrix-product shapes that training tuned.
+    let products = Products::inference(!crate::device::is_cpu_device(device), padded_n);
     let batch = match source {
         Spatial::Rows => {
             let mut spatial = Vec::with_capacity(samples.spatial.len() + pad * config.spatial_dim);
@@ -199,7 +196,7 @@ fn forward_padded(
         r.truncate(n);
         Ok(r)
     };
-    let out = model.forward(&batch);
+    let out = model.forward(&batch.with_products(products));
     let mut p = Prediction { f: rows(out.f, "f")?, ..Default::default() };
     if parts && let (Some(d), Some(s)) = (out.diffuse, out.specular) {
         let effective = match out.xi {

@@ -34,9 +34,9 @@ fn mat(t: &FlexTensor) -> Option<(usize, usize, MatRef)> {
 }
 
 /// A contiguous m x n f32 tensor whose every element `write` writes, allocated without zeroing
-/// when its size is a whole number of 16-byte words (a [32768, 128] activation: zeroing it was
-/// a 16 MB memset per product, 2.6 % of a training step), and 16-byte aligned, so that flex
-/// never copies it to realign.
+/// when its size is a whole number of 16-byte words (zeroing a [32768, 128] activation is a
+/// 16 MB memset per product, a visible share of a training step), and 16-byte aligned, so
+/// that flex never copies it to realign.
 ///
 /// # Safety
 /// `write` must write all m n elements it is given.

@@ -7,10 +7,10 @@
 //!
 //! The choice is per process (the environment is read once). An unknown value is refused when a
 //! GPU device is made ([`crate::device::BackendDevice::device`]), naming the variable. `ours` is the
-//! default since it was measured on an H200 (2026-11-28, `benches/README.md`): as fast as burn's
-//! kernels once burn's autotune has settled (Single MLP step 4.6 against 4.5 ms at 2^15, Disney
-//! 8.6 to 9.0 against 8.7), three times faster in a first process, before the autotune cache
-//! holds burn's shapes (4.6 against 14.2 ms), and its sums run in a fixed order.
+//! default because, measured on an H200, it is as fast as burn's kernels once burn's autotune has
+//! settled, several times faster in a first process, before the autotune cache holds burn's
+//! shapes, and its sums run in a fixed order (figures: `benches/README.md`, "Figures that left
+//! the source comments").
 //!
 //! Three settings of `ours`, for benchmarks and debugging, read (and a bad value refused) when
 //! a GPU device is made like the choice of kernels:

@@ -5,9 +5,9 @@
 //! malloc serves blocks above its mmap threshold (128 KiB, adapting upwards to at most
 //! 32 MiB) with fresh `mmap`ed pages and trims the top of the heap when more than its trim
 //! threshold is free, so every step page-faults each activation in again and the kernel zeroes
-//! it page by page. Measured on the 2-core bench machine (Single MLP step, flex): 303 ms with
-//! glibc's defaults, 181 ms with both thresholds raised (the same environment setting took
-//! PyTorch's step from 202 to 183 ms).
+//! it page by page. Raising both thresholds makes a CPU training step markedly faster, and
+//! PyTorch's too under the same setting (figures: `benches/README.md`, "Figures that left the
+//! source comments").
 //!
 //! [`keep_freed_tensor_memory`] raises both thresholds once per process (`mallopt`), so freed
 //! buffers return to malloc's free lists and the next step reuses them. The price is that the

@@ -58,11 +58,9 @@
 //! the rendered radiance, backward, Adam) at batch 32768 and prints samples/s and GFLOP/s
 //! against the matmul rate measured in the same run; `benches/pytorch_step.py` (repository
 //! root) is the same Single MLP step in PyTorch, and `BRDF_BENCH_PYTORCH=python3` runs the two
-//! back to back. Measured on the 2-core AVX-512 machine: Single MLP step 165 ms on flex
-//! against PyTorch 2.15's 213 to 221 ms in the same run (ratio 0.74 to 0.80), ndarray 1.8x
-//! slower than PyTorch. Two things get flex there: the host-memory policy ([`host_memory`],
-//! applied when a CPU device is made) and the allocation patch in `vendor/burn-flex`. Full
-//! figures and conditions are in the bench's file documentation and `benches/README.md`.
+//! back to back. Two things make flex's step faster than PyTorch's on the CPU: the host-memory
+//! policy ([`host_memory`], applied when a CPU device is made) and the allocation patch in
+//! `vendor/burn-flex`. The dated figures and their conditions are in `benches/README.md`.
 
 pub mod additive_separate;
 pub mod additive_shared;
@@ -89,6 +87,7 @@ pub mod output_init;
 pub mod param_ids;
 pub mod parametric;
 pub mod precision;
+pub mod products;
 pub mod record_table;
 pub mod single_mlp;
 pub mod tensor_brdf;

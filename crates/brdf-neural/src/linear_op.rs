@@ -21,8 +21,9 @@ use burn::tensor::Tensor;
 pub use kernels::LinearKernels;
 
 /// `x W + b` for x `[rows, d_in]`, W `[d_in, d_out]`, b `[d_out]`, its products in `precision`
-/// on the flex backend (f32 elsewhere: [`PrecisionScope::scope`](crate::precision::PrecisionScope::scope) refuses bf16 on other
-/// backends); burn's `linear` on every other backend.
+/// on the flex backend (f32 elsewhere:
+/// [`PrecisionSupport::check`](crate::precision::PrecisionSupport::check) refuses bf16 on
+/// other backends); burn's `linear` on every other backend.
 pub fn linear(
     x: Tensor<2>,
     weight: Tensor<2>,

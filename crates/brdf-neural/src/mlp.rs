@@ -11,6 +11,7 @@
 
 use crate::batch_split::linear;
 use crate::linear_op::relu;
+use crate::products::Products;
 use burn::module::Module;
 use burn::nn::{Linear, LinearConfig};
 use burn::tensor::{Device, Tensor};
@@ -99,7 +100,7 @@ impl Mlp {
     ///
     /// # Panics
     /// If `late` is given or missing against the configuration, or widths mismatch.
-    pub fn forward(&self, x: Tensor<2>, late: Option<Tensor<2>>) -> Tensor<2> {
+    pub fn forward(&self, x: Tensor<2>, late: Option<Tensor<2>>, products: Products) -> Tensor<2> {
         assert_eq!(late.is_some(), self.late_into != usize::MAX, "Mlp: late input mismatch");
         let (raw, mut late) = match late {
             Some(l) if self.late_into == 0 => (Tensor::cat(vec![x, l], 1), None),
@@ -107,16 +108,16 @@ impl Mlp {
         };
         let mut h = raw.clone();
         for (k, layer) in self.layers.iter().enumerate() {
-            let mut z = linear(layer, h);
+            let mut z = linear(layer, h, products);
             if k == self.skip_into
                 && let Some(skip) = &self.skip
             {
-                z = z + linear(skip, raw.clone());
+                z = z + linear(skip, raw.clone(), products);
             }
             if k == self.late_into
                 && let (Some(proj), Some(l)) = (&self.late, late.take())
             {
-                z = z + linear(proj, l);
+                z = z + linear(proj, l, products);
             }
             h = if k < self.hidden_layers { relu(z) } else { z };
         }
@@ -145,8 +146,11 @@ mod tests {
         assert_eq!(Mlp::new(&c, &device).num_params(), c.param_count());
         c.late_into = 3;
         assert_eq!(Mlp::new(&c, &device).num_params(), c.param_count());
-        let y = Mlp::new(&c, &device)
-            .forward(Tensor::<2>::ones([2, 10], &device), Some(Tensor::<2>::ones([2, 4], &device)));
+        let y = Mlp::new(&c, &device).forward(
+            Tensor::<2>::ones([2, 10], &device),
+            Some(Tensor::<2>::ones([2, 4], &device)),
+            Products::F32,
+        );
         assert_eq!(y.dims(), [2, 3]);
     }
 }

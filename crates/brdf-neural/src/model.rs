@@ -121,7 +121,8 @@ impl BrdfModel {
     }
 
     /// Evaluates the model on a batch built by [`BrdfBatch::new`] (or its siblings) for the
-    /// same configuration.
+    /// same configuration, its linear layers' products as the batch's
+    /// [`BrdfBatch::products`] say.
     ///
     /// # Shapes
     /// - batch: `batch` samples
@@ -131,14 +132,16 @@ impl BrdfModel {
     /// If the batch lacks the inputs the model needs (a batch of another configuration).
     pub fn forward(&self, batch: &BrdfBatch) -> BrdfOutput {
         let angles = || batch.angles.clone().expect("batch without angle features");
+        let (spatial, products) = (batch.spatial.clone(), batch.products);
         match self {
             BrdfModel::Parametric(m) => m.forward(
-                batch.spatial.clone(),
+                spatial,
                 batch.geometry.as_ref().expect("batch without geometry"),
+                products,
             ),
-            BrdfModel::SingleMlp(m) => m.forward(batch.spatial.clone(), angles()),
-            BrdfModel::AdditiveSeparate(m) => m.forward(batch.spatial.clone(), angles()),
-            BrdfModel::AdditiveShared(m) => m.forward(batch.spatial.clone(), angles()),
+            BrdfModel::SingleMlp(m) => m.forward(spatial, angles(), products),
+            BrdfModel::AdditiveSeparate(m) => m.forward(spatial, angles(), products),
+            BrdfModel::AdditiveShared(m) => m.forward(spatial, angles(), products),
         }
     }
 }

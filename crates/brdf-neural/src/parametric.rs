@@ -15,6 +15,8 @@
 
 use crate::mlp::Mlp;
 use crate::output::BrdfOutput;
+use crate::precision::MatmulPrecision;
+use crate::products::Products;
 use crate::tensor_brdf::{
     DisneyTensorParams, FmbrdfNets, FmbrdfTensorParams, Geometry, PhongTensorParams,
     TorranceSparrowTensorParams, disney, fmbrdf, realistic_phong, torrance_sparrow,
@@ -34,8 +36,8 @@ const FMBRDF_INIT: (f64, f64) = (0.3, 2.0);
 /// FMBRDF's two per-object scalars are stored divided by this gain and multiplied by it before
 /// their sigmoid. Adam's step is about the learning rate in the units of the stored value,
 /// whatever the gradient's size, so a lone scalar at rate 1e-3 needs thousands of steps to
-/// cross the O(1) span of its sigmoid's argument (measured on Spot x blue-acrylic: the test
-/// PSNR climbed from 33.9 dB at 800 steps to 39.4 dB at 9,000). The gain moves them as fast
+/// cross the O(1) span of its sigmoid's argument (on Spot x blue-acrylic the test PSNR was
+/// still climbing after thousands of steps; `benches/README.md`). The gain moves them as fast
 /// as the per-point parameters, which the MLP's many weights move together.
 pub const FMBRDF_GLOBAL_GAIN: f64 = 10.0;
 
@@ -125,7 +127,7 @@ impl ParametricModel {
     /// - spatial: `[batch, spatial_dim]`
     /// - output: per-sample tensors `[batch, k]` (FMBRDF alpha and beta `[1, 1]`)
     pub fn params(&self, spatial: Tensor<2>) -> BrdfParams {
-        self.params_of_outputs(self.mlp.forward(spatial, None))
+        self.params_of_outputs(self.mlp.forward(spatial, None, Products::F32))
     }
 
     /// The BRDF parameters of each sample from the parameter MLP's raw outputs (the output
@@ -197,8 +199,14 @@ impl ParametricModel {
     /// # Shapes
     /// - spatial: `[batch, spatial_dim]`; geometry of `batch` pairs
     /// - output: `f` `[batch, 3]`
-    pub fn forward(&self, spatial: Tensor<2>, geometry: &Geometry) -> BrdfOutput {
-        let f = self.brdf_of_outputs(self.mlp.forward(spatial, None), geometry);
+    pub fn forward(
+        &self,
+        spatial: Tensor<2>,
+        geometry: &Geometry,
+        products: Products,
+    ) -> BrdfOutput {
+        let z = self.mlp.forward(spatial, None, products);
+        let f = self.brdf_of_outputs(z, geometry, products.precision);
         BrdfOutput { f, diffuse: None, specular: None, xi: None }
     }
 
@@ -208,13 +216,18 @@ impl ParametricModel {
     /// # Shapes
     /// - z: `[batch, outputs]`; geometry of `batch` pairs
     /// - output: `f` `[batch, 3]`
-    pub fn brdf_of_outputs(&self, z: Tensor<2>, geometry: &Geometry) -> Tensor<2> {
+    pub fn brdf_of_outputs(
+        &self,
+        z: Tensor<2>,
+        geometry: &Geometry,
+        precision: MatmulPrecision,
+    ) -> Tensor<2> {
         match self.params_of_outputs(z) {
             BrdfParams::RealisticPhong(p) => realistic_phong(&p, geometry),
             BrdfParams::TorranceSparrow(p) => torrance_sparrow(&p, geometry),
             BrdfParams::Disney(p) => disney(&p, geometry),
             BrdfParams::Fmbrdf(p) => {
-                fmbrdf(&p, self.fm_nets.as_ref().expect("FMBRDF nets"), geometry)
+                fmbrdf(&p, self.fm_nets.as_ref().expect("FMBRDF nets"), geometry, precision)
             }
         }
     }

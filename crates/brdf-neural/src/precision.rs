@@ -10,48 +10,30 @@
 //! tensor cores (`gpu-kernels`' `gemm_cmma`), PyTorch's bf16 autocast for the linear layers.
 //! The flex and cuda backends implement it; the others refuse it.
 //!
-//! The setting belongs to the training loop of one thread: [`PrecisionScope::scope`] applies
-//! it to the linear layers of the models that thread runs until the returned guard drops, so an
-//! evaluation on another thread (or after the fit) keeps f32; [`PrecisionScope::f32_scope`]
-//! returns to f32 inside a bf16 scope (the training loop's validation loss, which decides the
-//! plateau schedule, is f32). The layers read it when they run ([`PrecisionScope::current`])
-//! and hand it to the kernels as an argument of each product ([`crate::linear_op`]), which keep
-//! it for the product's backward pass; no other matrix product in the process is affected.
-//! Products that gain nothing (narrow heads such as the 3-channel output, small products) stay
-//! f32.
-
-use std::cell::Cell;
-
-thread_local! {
-    static CURRENT: Cell<MatmulPrecision> = const { Cell::new(MatmulPrecision::F32) };
-}
+//! The precision is part of a batch's [`crate::products::Products`]: a training loop's step
+//! batches carry the run's precision, every other batch (the validation loss, which decides
+//! the plateau schedule, and every evaluation) plain f32. The layers hand it to the kernels as
+//! an argument of each product ([`crate::linear_op`]), which keep it for the product's
+//! backward pass; no other matrix product in the process is affected. Products that gain
+//! nothing (narrow heads such as the 3-channel output, small products) stay f32.
 
 /// The precisions' names (model-spec's, so that a run's configuration needs no tensor library).
 pub use model_spec::MatmulPrecision;
 
-/// What this crate does with a [`MatmulPrecision`]: applies it to the calling thread's
-/// products ([`PrecisionScope::scope`]) and says what the CPU runs natively.
-pub trait PrecisionScope {
-    /// Applies this precision to the matrix products the calling thread issues on `backend`
-    /// until the guard drops.
+/// What this crate knows of a [`MatmulPrecision`]: where it runs
+/// ([`PrecisionSupport::check`]) and what the CPU runs natively.
+pub trait PrecisionSupport {
+    /// Whether `backend` runs this precision's products.
     ///
     /// # Errors
     /// [`crate::Error::Spec`] (an invalid configuration) for bf16 on a backend other than flex
     /// and cuda, and on cuda with burn's kernels for the linear layers
     /// (`NEURAL_BRDF_GPU_LINEAR=burn`, [`crate::gpu_linear`]).
-    fn scope(self, backend: crate::device::Backend) -> crate::Result<PrecisionGuard>;
-
-    /// Plain f32 products on the calling thread until the guard drops, whatever was set before
-    /// (a training loop's validation loss and other measurements inside a bf16 scope).
-    fn f32_scope() -> PrecisionGuard;
-
-    /// The precision of the linear layers the calling thread runs now (f32 outside a
-    /// [`PrecisionScope::scope`]).
-    fn current() -> MatmulPrecision;
+    fn check(self, backend: crate::device::Backend) -> crate::Result<()>;
 
     /// Whether this CPU has Intel's AMX-BF16 tile unit (Xeons from Sapphire Rapids on; CPUID
     /// leaf 7, EDX bit 22). The flex backend's bf16 products run on it when Linux grants the
-    /// tile registers ([`PrecisionScope::bf16_on_amx`]); without it they take the AVX512-BF16
+    /// tile registers ([`PrecisionSupport::bf16_on_amx`]); without it they take the AVX512-BF16
     /// kernel, measured slower than f32 on such a Xeon (`benches/README.md`, "bf16 on an Intel
     /// Xeon with AMX"), and the trainer warns.
     fn cpu_has_amx_bf16() -> bool;
@@ -68,12 +50,12 @@ pub trait PrecisionScope {
     fn bf16_native() -> bool;
 }
 
-impl PrecisionScope for MatmulPrecision {
-    fn scope(self, backend: crate::device::Backend) -> crate::Result<PrecisionGuard> {
+impl PrecisionSupport for MatmulPrecision {
+    fn check(self, backend: crate::device::Backend) -> crate::Result<()> {
         use crate::device::Backend;
         use crate::gpu_linear::GpuLinear;
         if self == MatmulPrecision::F32 {
-            return Ok(PrecisionGuard { previous: None });
+            return Ok(());
         }
         let refused = match backend {
             Backend::Flex => None,
@@ -97,16 +79,8 @@ impl PrecisionScope for MatmulPrecision {
         };
         match refused {
             Some(why) => Err(model_spec::Error::InvalidConfig(why).into()),
-            None => Ok(PrecisionGuard { previous: Some(set(self)) }),
+            None => Ok(()),
         }
-    }
-
-    fn f32_scope() -> PrecisionGuard {
-        PrecisionGuard { previous: Some(set(MatmulPrecision::F32)) }
-    }
-
-    fn current() -> MatmulPrecision {
-        CURRENT.with(Cell::get)
     }
 
     fn cpu_has_amx_bf16() -> bool {
@@ -151,27 +125,9 @@ impl PrecisionScope for MatmulPrecision {
     }
 }
 
-/// Restores the thread's previous matrix-product precision when dropped.
-#[must_use = "the precision applies only while the guard lives"]
-pub struct PrecisionGuard {
-    previous: Option<MatmulPrecision>,
-}
-
-impl Drop for PrecisionGuard {
-    fn drop(&mut self) {
-        if let Some(p) = self.previous {
-            set(p);
-        }
-    }
-}
-
-fn set(p: MatmulPrecision) -> MatmulPrecision {
-    CURRENT.with(|c| c.replace(p))
-}
-
 #[cfg(test)]
 mod tests {
-    use super::{MatmulPrecision, PrecisionScope};
+    use super::{MatmulPrecision, PrecisionSupport};
 
     /// The CPUID bit agrees with the kernel's own reading of it (Linux's `amx_bf16` flag).
     #[test]

@@ -182,7 +182,7 @@ impl BrdfBatch {
             a.clone().select(0, rows.clone())
         });
         let geometry = table.geometry.as_ref().map(|g| g.select(&index.rows, &index.host));
-        Ok(BrdfBatch { spatial, angles, geometry })
+        Ok(BrdfBatch { spatial, angles, geometry, products: crate::products::Products::F32 })
     }
 }
 

@@ -7,6 +7,7 @@
 
 use crate::mlp::Mlp;
 use crate::output::BrdfOutput;
+use crate::products::Products;
 use burn::module::Module;
 use burn::tensor::Tensor;
 use burn::tensor::activation::softplus;
@@ -36,8 +37,8 @@ impl SingleMlp {
     /// # Shapes
     /// - spatial: `[batch, spatial_dim]`; angles: `[batch, angle_dim]`
     /// - output: `f` `[batch, 3]`
-    pub fn forward(&self, spatial: Tensor<2>, angles: Tensor<2>) -> BrdfOutput {
-        let z = self.mlp.forward(spatial, Some(angles));
+    pub fn forward(&self, spatial: Tensor<2>, angles: Tensor<2>, products: Products) -> BrdfOutput {
+        let z = self.mlp.forward(spatial, Some(angles), products);
         let f = softplus(z, 1.0).mul_scalar(self.output_scale);
         BrdfOutput { f, diffuse: None, specular: None, xi: None }
     }

@@ -12,7 +12,7 @@
 use brdf_neural::device::{self, Backend};
 use brdf_neural::linear_op::linear;
 use brdf_neural::precision::MatmulPrecision;
-use brdf_neural::precision::PrecisionScope;
+use brdf_neural::precision::PrecisionSupport;
 use burn::tensor::{Tensor, TensorData};
 
 /// Deterministic values in [-1, 1).
@@ -56,13 +56,16 @@ fn assert_same_bits(got: &[u32], want: &[u32], what: &str) {
 }
 
 /// The layer with the bias fused, the layer without bias plus a broadcast add, and burn-flex's
-/// own product plus the add, as bit patterns, in the calling thread's precision.
-fn fused_and_plain(m: usize, k: usize, n: usize, seed: u64) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
+/// own product plus the add, as bit patterns, the layers' products in precision `p`.
+fn fused_and_plain(
+    (m, k, n): (usize, usize, usize),
+    seed: u64,
+    p: MatmulPrecision,
+) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
     let d = device::cpu();
     let x = Tensor::<2>::from_data(TensorData::new(values(m * k, seed), [m, k]), &d);
     let w = Tensor::<2>::from_data(TensorData::new(values(k * n, seed + 1), [k, n]), &d);
     let b = Tensor::<1>::from_data(TensorData::new(values(n, seed + 2), [n]), &d);
-    let p = MatmulPrecision::current();
     let fused = linear(x.clone(), w.clone(), Some(b.clone()), p);
     let plain = linear(x.clone(), w.clone(), None, p) + b.clone().unsqueeze::<2>();
     let flex = x.matmul(w) + b.unsqueeze::<2>();
@@ -72,7 +75,7 @@ fn fused_and_plain(m: usize, k: usize, n: usize, seed: u64) -> (Vec<u32>, Vec<u3
 #[test]
 fn f32_linear_layers_equal_the_product_plus_the_bias_to_the_bit() {
     for (i, &(m, k, n)) in SHAPES.iter().enumerate() {
-        let (fused, plain, flex) = fused_and_plain(m, k, n, 10 * i as u64);
+        let (fused, plain, flex) = fused_and_plain((m, k, n), 10 * i as u64, MatmulPrecision::F32);
         assert_same_bits(&fused, &plain, &format!("[{m}, {k}] x [{k}, {n}] + b"));
         assert_same_bits(&fused, &flex, &format!("[{m}, {k}] x [{k}, {n}] + b against flex"));
     }
@@ -84,9 +87,10 @@ fn bf16_linear_layers_equal_the_product_plus_the_bias_to_the_bit() {
     for amx in kernels {
         // Process-wide; the other tests here run f32, which no bf16 kernel touches.
         MatmulPrecision::set_bf16_amx_enabled(amx);
-        let _g = MatmulPrecision::Bf16.scope(Backend::Flex).unwrap();
+        MatmulPrecision::Bf16.check(Backend::Flex).unwrap();
         for (i, &(m, k, n)) in SHAPES.iter().enumerate() {
-            let (fused, plain, _) = fused_and_plain(m, k, n, 100 + 10 * i as u64);
+            let seed = 100 + 10 * i as u64;
+            let (fused, plain, _) = fused_and_plain((m, k, n), seed, MatmulPrecision::Bf16);
             let what = format!("bf16 (AMX: {amx}) [{m}, {k}] x [{k}, {n}] + b");
             assert_same_bits(&fused, &plain, &what);
         }

@@ -26,11 +26,12 @@
 mod common;
 
 use brdf_neural::device::{Backend, BackendDevice};
-use brdf_neural::precision::PrecisionScope;
+use brdf_neural::precision::{MatmulPrecision, PrecisionSupport};
+use brdf_neural::products::Products;
 use brdf_neural::{BrdfBatch, BrdfModel, ModelConfig, ModelKind, SpatialTable};
 use burn::module::Module;
 use burn::tensor::{Device, Tensor, TensorData};
-use common::{OwnedSamples, parameters, rng, samples, small, train, values};
+use common::{OwnedSamples, parameters, rng, samples, small, train_with, values};
 use test_support::assert_close_scaled;
 
 /// The backend under test: `BRDF_GPU_BACKEND`, else wgpu when built, else cuda.
@@ -100,21 +101,22 @@ fn curve_data(c: &ModelConfig, seed: u64) -> Vec<(OwnedSamples, Vec<f32>)> {
 }
 
 /// The loss curves of 30 Adam steps on `data` on the CPU and on the GPU from the same start
-/// (initial weights of seed `init`), the GPU's with its linear layers' batch split into
-/// `parts`; and the model trained on the GPU.
+/// (initial weights of seed `init`), both with `precision` products, the GPU's with its linear
+/// layers' batch split into `parts`; and the model trained on the GPU.
 fn loss_curves(
     c: &ModelConfig,
     data: &[(OwnedSamples, Vec<f32>)],
     init: u64,
-    parts: usize,
+    (parts, precision): (usize, MatmulPrecision),
 ) -> (Vec<f32>, Vec<f32>, BrdfModel) {
     let cpu = brdf_neural::device::cpu_training();
     let gpu_device = gpu().training_device().unwrap();
     let model = BrdfModel::init_seeded(c, &cpu, init, None).unwrap();
     let on_gpu = model.clone().fork(&gpu_device);
-    let (_, l_cpu) = train(model, c, data, 30, 3e-3, &cpu);
-    let _split = brdf_neural::batch_split::scope(parts);
-    let (trained, l_gpu) = train(on_gpu, c, data, 30, 3e-3, &gpu_device);
+    let on_cpu = Products { precision, parts: 1 };
+    let (_, l_cpu) = train_with(model, c, data, (30, 3e-3), &cpu, on_cpu);
+    let on_gpu_products = Products { precision, parts };
+    let (trained, l_gpu) = train_with(on_gpu, c, data, (30, 3e-3), &gpu_device, on_gpu_products);
     assert!(l_cpu[29] < 0.5 * l_cpu[0], "the CPU fit learns: {l_cpu:?}");
     (l_cpu, l_gpu, trained)
 }
@@ -123,7 +125,7 @@ fn loss_curves(
 fn a_single_mlp_trains_along_the_same_loss_curve_on_the_gpu() {
     let c = small(ModelKind::SingleMlp);
     let data = curve_data(&c, 7);
-    let (l_cpu, l_gpu, trained) = loss_curves(&c, &data, 5, 1);
+    let (l_cpu, l_gpu, trained) = loss_curves(&c, &data, 5, (1, MatmulPrecision::F32));
     assert_close_scaled("loss curve", &l_gpu, &l_cpu, 1e-3);
     // The trained GPU model comes back to the CPU intact.
     let cpu = brdf_neural::device::cpu_training();
@@ -136,7 +138,7 @@ fn a_single_mlp_trains_along_the_same_loss_curve_on_the_gpu() {
 fn the_batch_split_trains_along_the_same_loss_curve_on_the_gpu() {
     let c = small(ModelKind::SingleMlp);
     // Two parts of 256 rows each: the split path (batch_split::MIN_ROWS).
-    let (l_cpu, l_gpu, _) = loss_curves(&c, &curve_data(&c, 9), 6, 2);
+    let (l_cpu, l_gpu, _) = loss_curves(&c, &curve_data(&c, 9), 6, (2, MatmulPrecision::F32));
     assert_close_scaled("loss curve with the batch split", &l_gpu, &l_cpu, 1e-3);
 }
 
@@ -146,20 +148,15 @@ fn the_batch_split_trains_along_the_same_loss_curve_on_the_gpu() {
 /// instructions, bf16 is refused, and the refusal says where it runs.
 #[test]
 fn bf16_trains_along_the_cpus_bf16_curve_or_is_refused() {
-    use brdf_neural::precision::MatmulPrecision;
     let backend = gpu();
-    let guard = match MatmulPrecision::Bf16.scope(backend) {
-        Ok(guard) => guard,
-        Err(e) => {
-            let e = e.to_string();
-            assert!(backend == Backend::Wgpu && e.contains("--backend cuda"), "{backend}: {e}");
-            return;
-        }
-    };
+    if let Err(e) = MatmulPrecision::Bf16.check(backend) {
+        let e = e.to_string();
+        assert!(backend == Backend::Wgpu && e.contains("--backend cuda"), "{backend}: {e}");
+        return;
+    }
     let c = small(ModelKind::SingleMlp);
     let data = curve_data(&c, 11);
-    let (l_cpu, l_gpu, _) = loss_curves(&c, &data, 8, 1);
-    drop(guard);
+    let (l_cpu, l_gpu, _) = loss_curves(&c, &data, 8, (1, MatmulPrecision::Bf16));
     assert_close_scaled("bf16 loss curve", &l_gpu, &l_cpu, 1e-2);
 }
 

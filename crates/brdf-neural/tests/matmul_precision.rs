@@ -10,7 +10,7 @@
 use brdf_neural::device::Backend;
 use brdf_neural::device::BackendDevice;
 use brdf_neural::precision::MatmulPrecision;
-use brdf_neural::precision::PrecisionScope;
+use brdf_neural::precision::PrecisionSupport;
 use burn::tensor::{Tensor, TensorData};
 
 fn rng(seed: u64) -> impl FnMut() -> f32 {
@@ -62,7 +62,13 @@ enum Layout {
     RhsTransposed,
 }
 
-fn product(a: &[f32], b: &[f32], m: usize, k: usize, n: usize, layout: Layout) -> Vec<f32> {
+fn product(
+    a: &[f32],
+    b: &[f32],
+    (m, k, n): (usize, usize, usize),
+    layout: Layout,
+    precision: MatmulPrecision,
+) -> Vec<f32> {
     let device = Backend::Flex.device().unwrap();
     let transpose = |v: &[f32], r: usize, c: usize| {
         let mut t = vec![0.0; r * c];
@@ -85,9 +91,8 @@ fn product(a: &[f32], b: &[f32], m: usize, k: usize, n: usize, layout: Layout) -
         }
         _ => Tensor::from_data(TensorData::new(b.to_vec(), [k, n]), &device),
     };
-    // A linear layer without bias: the products the models' layers issue, in the precision of
-    // the calling thread's scope.
-    brdf_neural::linear_op::linear(lhs, rhs, None, MatmulPrecision::current())
+    // A linear layer without bias: the products the models' layers issue.
+    brdf_neural::linear_op::linear(lhs, rhs, None, precision)
         .into_data()
         .try_to_vec::<f32>()
         .unwrap()
@@ -135,10 +140,7 @@ fn check_bf16_products(amx: bool) {
             let mut r = rng(si as u64 * 3 + layout as u64);
             let a: Vec<f32> = (0..m * k).map(|_| r()).collect();
             let b: Vec<f32> = (0..k * n).map(|_| r()).collect();
-            let got = {
-                let _g = MatmulPrecision::Bf16.scope(Backend::Flex).unwrap();
-                product(&a, &b, m, k, n, layout)
-            };
+            let got = product(&a, &b, (m, k, n), layout, MatmulPrecision::Bf16);
             let (want, scale) = reference(&a, &b, m, k, n, bf16);
             let err = max_scaled_error(&got, &want, &scale);
             // f32 sums of k terms: a few ulp of the sum of magnitudes.
@@ -158,32 +160,55 @@ fn check_bf16_products(amx: bool) {
 }
 
 #[test]
-fn default_precision_is_plain_f32_and_the_guard_restores_it() {
+fn f32_is_plain_f32_and_bf16_the_rounded_product_on_any_thread() {
     let (m, k, n) = (512, 128, 64);
     let mut r = rng(99);
     let a: Vec<f32> = (0..m * k).map(|_| r()).collect();
     let b: Vec<f32> = (0..k * n).map(|_| r()).collect();
     let (exact, scale) = reference(&a, &b, m, k, n, |x| x as f64);
-    {
-        let _g = MatmulPrecision::Bf16.scope(Backend::Flex).unwrap();
-    }
-    let got = product(&a, &b, m, k, n, Layout::RowMajor);
-    let err = max_scaled_error(&got, &exact, &scale);
-    assert!(err < 1e-5, "after the guard dropped the product is not f32: {err:e}");
-    // Another thread never sees this thread's setting.
-    let _g = MatmulPrecision::Bf16.scope(Backend::Flex).unwrap();
-    {
-        // f32_scope returns to plain f32 inside a bf16 scope (the validation loss).
-        let _f32 = MatmulPrecision::f32_scope();
-        let inner = product(&a, &b, m, k, n, Layout::RowMajor);
-        assert!(max_scaled_error(&inner, &exact, &scale) < 1e-5);
-    }
     let (rounded, _) = reference(&a, &b, m, k, n, bf16);
-    let restored = product(&a, &b, m, k, n, Layout::RowMajor);
-    assert!(max_scaled_error(&restored, &rounded, &scale) < 1e-5, "bf16 not restored");
-    let other =
-        std::thread::spawn(move || product(&a, &b, m, k, n, Layout::RowMajor)).join().unwrap();
-    assert!(max_scaled_error(&other, &exact, &scale) < 1e-5);
+    let plain = product(&a, &b, (m, k, n), Layout::RowMajor, MatmulPrecision::F32);
+    assert!(max_scaled_error(&plain, &exact, &scale) < 1e-5, "f32 is not the plain product");
+    let bf = product(&a, &b, (m, k, n), Layout::RowMajor, MatmulPrecision::Bf16);
+    assert!(max_scaled_error(&bf, &rounded, &scale) < 1e-5, "bf16 is not the rounded product");
+    // The same on another thread: nothing of a product's precision lives in the thread.
+    let (a2, b2) = (a.clone(), b.clone());
+    let other = std::thread::spawn(move || {
+        product(&a2, &b2, (m, k, n), Layout::RowMajor, MatmulPrecision::Bf16)
+    })
+    .join()
+    .unwrap();
+    assert!(other == bf, "bf16 differs between threads");
+}
+
+/// A batch runs plain f32 products unless it is told otherwise, and a bf16 batch changes the
+/// model's output without changing the next f32 batch's.
+#[test]
+fn a_batch_carries_its_products() {
+    use brdf_neural::products::Products;
+    use brdf_neural::{BrdfBatch, BrdfModel, ModelConfig, ModelKind, Samples};
+    let device = Backend::Flex.device().unwrap();
+    let c = ModelConfig { kind: ModelKind::SingleMlp, spatial_dim: 8, ..ModelConfig::default() };
+    let model = BrdfModel::init_seeded(&c, &device, 5, None).unwrap();
+    let n = 4096;
+    let mut r = rng(3);
+    let spatial: Vec<f32> = (0..n * 8).map(|_| r()).collect();
+    let dir = |x: f32, y: f32| {
+        let z = (1.0 - x * x - y * y).max(0.01).sqrt();
+        let len = (x * x + y * y + z * z).sqrt();
+        [x / len, y / len, z / len]
+    };
+    let l: Vec<[f32; 3]> = (0..n).map(|_| dir(0.5 * r(), 0.5 * r())).collect();
+    let v: Vec<[f32; 3]> = (0..n).map(|_| dir(0.5 * r(), 0.5 * r())).collect();
+    let batch =
+        BrdfBatch::new(&c, &Samples { spatial: &spatial, l: &l, v: &v }, None, &device).unwrap();
+    assert_eq!(batch.products, Products::F32);
+    let f = |b: &BrdfBatch| model.forward(b).f.into_data().try_to_vec::<f32>().unwrap();
+    let plain = f(&batch);
+    let bf16 = Products::training(MatmulPrecision::Bf16, Backend::Flex, n).unwrap();
+    let rounded = f(&batch.clone().with_products(bf16));
+    assert!(plain != rounded, "bf16 products left the output unchanged");
+    assert!(f(&batch) == plain, "an f32 batch after a bf16 one changed");
 }
 
 #[test]
@@ -207,8 +232,7 @@ fn narrow_and_small_products_stay_f32_under_bf16() {
         let mut r = rng(7);
         let a: Vec<f32> = (0..m * k).map(|_| r()).collect();
         let b: Vec<f32> = (0..k * n).map(|_| r()).collect();
-        let _g = MatmulPrecision::Bf16.scope(Backend::Flex).unwrap();
-        let got = product(&a, &b, m, k, n, Layout::RowMajor);
+        let got = product(&a, &b, (m, k, n), Layout::RowMajor, MatmulPrecision::Bf16);
         let (exact, scale) = reference(&a, &b, m, k, n, |x| x as f64);
         assert!(max_scaled_error(&got, &exact, &scale) < 1e-5, "{m}x{k}x{n}");
     }
@@ -217,16 +241,16 @@ fn narrow_and_small_products_stay_f32_under_bf16() {
 #[test]
 fn bf16_is_refused_where_no_kernel_implements_it() {
     for backend in [Backend::NdArray, Backend::Wgpu] {
-        let e = MatmulPrecision::Bf16.scope(backend).err().expect("refused").to_string();
+        let e = MatmulPrecision::Bf16.check(backend).expect_err("refused").to_string();
         assert!(e.contains("bf16"), "{backend}: {e}");
     }
     // wgpu's refusal says where bf16 runs on a GPU.
-    let e = MatmulPrecision::Bf16.scope(Backend::Wgpu).err().expect("refused").to_string();
+    let e = MatmulPrecision::Bf16.check(Backend::Wgpu).expect_err("refused").to_string();
     assert!(e.contains("--backend cuda") && e.contains("tensor cores"), "{e}");
-    assert!(MatmulPrecision::Bf16.scope(Backend::Flex).is_ok());
+    assert!(MatmulPrecision::Bf16.check(Backend::Flex).is_ok());
     // On cuda, the gpu-kernels' tensor-core products (the default kernels) implement it.
     if std::env::var(brdf_neural::gpu_linear::VAR).is_err() {
-        assert!(MatmulPrecision::Bf16.scope(Backend::Cuda).is_ok());
+        assert!(MatmulPrecision::Bf16.check(Backend::Cuda).is_ok());
     }
-    assert!(MatmulPrecision::F32.scope(Backend::Wgpu).is_ok());
+    assert!(MatmulPrecision::F32.check(Backend::Wgpu).is_ok());
 }

@@ -24,8 +24,9 @@ use crate::{Error, Result};
 use brdf_neural::device::{Backend, BackendDevice};
 use brdf_neural::fitted::{DeviceRecords, device_records, device_table};
 use brdf_neural::precision::MatmulPrecision;
-use brdf_neural::precision::PrecisionScope;
-use brdf_neural::{BrdfModel, SpatialTable, batch_split};
+use brdf_neural::precision::PrecisionSupport;
+use brdf_neural::products::Products;
+use brdf_neural::{BrdfModel, SpatialTable};
 use burn::module::Module;
 use burn::optim::{AdamConfig, ModuleOptimizer};
 use burn::tensor::Device;
@@ -236,12 +237,18 @@ pub fn fit_and_keep(
     let (spatial, val_spatial, records) = device_inputs(config, (&data, &val), on_device, &device)?;
     let gpu_reads = if options.backend.is_gpu() { GPU_LOSS_READS } else { 1 };
     let loss_reads = options.loss_reads.or(loss_reads_from_env()?).unwrap_or(gpu_reads).max(1);
+    // The training steps' products: the run's precision (checked against the backend), and on
+    // a GPU the weight gradients' sum over the batch split into parts (split-K), which the
+    // GPU's matrix-product kernels do not split themselves. Evaluation keeps plain f32.
+    let products = Products::training(t.matmul_precision, options.backend, t.batch_size)?;
+    warn_of_slow_bf16(run, t.matmul_precision, options.backend);
     let lp = Loop {
         config,
         run: &dir,
         data: &data,
         val: &val,
         device,
+        products,
         spatial,
         val_spatial,
         records,
@@ -250,17 +257,9 @@ pub fn fit_and_keep(
         started,
         startup_seconds: Default::default(),
     };
-    // The matrix-product precision of this thread's training steps; evaluation keeps f32.
-    let precision = t.matmul_precision.scope(options.backend)?;
-    warn_of_slow_bf16(run, t.matmul_precision, options.backend);
-    // On a GPU, the weight gradients' sum over the batch is split into parts (split-K): the
-    // GPU's matrix-product kernels do not split it themselves. The CPU keeps the plain product.
-    let parts = if options.backend.is_gpu() { batch_split::gpu_parts(t.batch_size) } else { 1 };
-    let split = batch_split::scope(parts);
     let (hook, stop_after) = (options.hook, options.stop_after);
     let run_loop = || lp.run(model, &mut optim, state, last_checkpoint, hook, stop_after);
     let end = guarded(run_loop, &lp, (&dir, options.backend))?;
-    drop((precision, split));
     let (model, state) = match end {
         LoopEnd::Done(done) => *done,
         LoopEnd::Interrupted(step) => return Ok((FitOutcome::Stopped(step), None)),

@@ -13,7 +13,7 @@ use crate::loss::{LossWeights, loss, srgb_oetf};
 use crate::loss_window::{FreshLeaves, LossWindow, ReadStep, StepLoss, WindowStart};
 use crate::{Error, Result};
 use brdf_neural::fitted::{DeviceRecords, predict_on};
-use brdf_neural::precision::PrecisionScope;
+use brdf_neural::products::Products;
 use brdf_neural::{BrdfBatch, BrdfModel, Reciprocity, Samples, SpatialTable};
 use burn::module::Module;
 use burn::optim::{GradientsParams, ModuleOptimizer};
@@ -52,6 +52,9 @@ pub(crate) struct Loop<'a> {
     pub val: &'a RecordSet,
     /// The training (autodiff) device.
     pub device: Device,
+    /// How the training steps' linear layers compute their products (the run's
+    /// `matmul_precision`, the batch split on a GPU); validation runs plain f32.
+    pub products: Products,
     /// On a GPU: the spatial rows of every point, on the device, where each batch selects its
     /// rows ([`brdf_neural::fitted::device_table`]); `None`: batches gather them on the CPU.
     pub spatial: Option<SpatialTable>,
@@ -307,7 +310,7 @@ impl Loop<'_> {
         let indices: Vec<usize> = (0..bs).map(|_| rng.random_range(0..n)).collect();
         let (batch, weight, target) = self.batch(&indices, &mut rng, timer)?;
         timer.charge(Phase::Encode);
-        let out = model.forward(&batch);
+        let out = model.forward(&batch.with_products(self.products));
         timer.charge(Phase::Forward);
         let weights = LossWeights {
             diffuse: t.diffuse_reg_weight,
@@ -401,12 +404,11 @@ impl Loop<'_> {
         if self.val.is_empty() || !state.step.is_multiple_of(t.validate_every) {
             return Ok(None);
         }
-        // In f32 even when the steps run bf16 products: the plateau rule compares these losses.
-        let f32_products = brdf_neural::precision::MatmulPrecision::f32_scope();
+        // In f32 even when the steps run bf16 products (the evaluation's batches are plain f32):
+        // the plateau rule compares these losses.
         let inference = self.device.clone().inner();
         let table = self.val_spatial.as_ref();
         let v = validation_loss(model, self.config, self.val, table, &inference)?;
-        drop(f32_products);
         match state.plateau.update(state.step, v, t) {
             Decision::Stop => state.stopped = Some(StopReason::Plateau),
             Decision::Decayed | Decision::Continue => {}

@@ -1,7 +1,7 @@
 //! Which burn backend runs a model, and how a training step's matrix products are computed:
 //! the names a run's configuration and `metrics.json` record. brdf-neural makes the devices
-//! and applies the precision (`brdf_neural::device::BackendDevice`,
-//! `brdf_neural::precision::PrecisionScope`); here they are only values, so that the crates
+//! and checks the precision (`brdf_neural::device::BackendDevice`,
+//! `brdf_neural::precision::PrecisionSupport`); here they are only values, so that the crates
 //! that read a run's records compile no tensor library.
 
 use serde::{Deserialize, Serialize};

@@ -227,10 +227,9 @@ impl Geometry {
 /// `body` pair-major.
 ///
 /// The stride is `len` plus one cache line: with a stride of exactly `len` (a multiple of 4 KiB
-/// for a batch of 8,192), the 16 writes of one pair would land in the same L1 cache set.
-/// Measured with the `tensor_brdf` bench (8,192 pairs): `Geometry::new` took 0.41 ms without
-/// the padding and 0.34 ms with it, split over 2 threads in chunks of 1,024 pairs; 0.27 ms on
-/// one thread, in one piece, as it is now.
+/// for a batch of 8,192), the 16 writes of one pair would land in the same L1 cache set. The
+/// `tensor_brdf` bench measures `Geometry::new` with and without the padding; one thread, in
+/// one piece, was the fastest (`benches/README.md`).
 struct Terms {
     stride: usize,
     base: Vec<f32>,

@@ -76,18 +76,31 @@ pub fn parameters<M: Module>(m: &M) -> Vec<Vec<f32>> {
 /// Adam on the MSE between `model(batch).f * weight` and `target`; returns the trained model
 /// and the loss of every step.
 pub fn train(
-    mut model: BrdfModel,
+    model: BrdfModel,
     config: &ModelConfig,
     data: &[(OwnedSamples, Vec<f32>)],
     steps: usize,
     lr: f64,
     device: &Device,
 ) -> (BrdfModel, Vec<f32>) {
+    train_with(model, config, data, (steps, lr), device, brdf_neural::products::Products::F32)
+}
+
+/// [`train`] with the batches' linear-layer products as `products` say.
+pub fn train_with(
+    mut model: BrdfModel,
+    config: &ModelConfig,
+    data: &[(OwnedSamples, Vec<f32>)],
+    (steps, lr): (usize, f64),
+    device: &Device,
+    products: brdf_neural::products::Products,
+) -> (BrdfModel, Vec<f32>) {
     let mut optim = AdamConfig::new().init();
     let batches: Vec<_> = data
         .iter()
         .map(|(s, t)| {
             let b = BrdfBatch::new(config, &s.view(), None, device).unwrap();
+            let b = b.with_products(products);
             let target = Tensor::<2>::from_data(
                 burn::tensor::TensorData::new(t.clone(), [s.l.len(), 3]),
                 device,
