@@ -7,25 +7,11 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-const PROFILE: &str = r#"
-name = "embedded"
-description = "the embedded mesh, away from the source tree"
-[data]
-meshes = ["embedded:spot"]
-materials = ["blue-acrylic"]
-size = 16
-views = 2
-lights = 4
-[run]
-seed = 1
-[run.model]
-width = 16
-[run.features.lbo]
-k_max = 32
-first = 16
-blocks = 1
-block_len = 8
-[run.train]
+/// One Disney run on the embedded mesh at 16 px, without images or probes.
+fn profile() -> String {
+    let head = "the embedded mesh, away from the source tree";
+    test_support::TinyProfile::new("embedded", head, 1).scene(16, 2, 4).with(
+        r#"[run.train]
 iterations = 4
 batch_size = 256
 warmup_steps = 1
@@ -39,7 +25,9 @@ reciprocity_pairs = 0
 images = false
 [sweep]
 models = ["disney"]
-"#;
+"#,
+    )
+}
 
 /// A fresh directory under the system's temporary directory (outside the source tree, which
 /// holds the tests' usual temporary folders).
@@ -62,7 +50,7 @@ fn the_embedded_mesh_needs_no_source_tree() {
     let dir = outside_dir();
     let exe = dir.join("xtask");
     std::fs::copy(env!("CARGO_BIN_EXE_xtask"), &exe).unwrap();
-    std::fs::write(dir.join("p.toml"), PROFILE).unwrap();
+    std::fs::write(dir.join("p.toml"), profile()).unwrap();
     let source = std::path::absolute(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
         .unwrap()
         .canonicalize()

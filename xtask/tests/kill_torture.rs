@@ -25,25 +25,11 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-const PROFILE: &str = r#"
-name = "torture"
-description = "kill -9 torture: one small scene, four models, snapshots, the NOL ablation"
-[data]
-meshes = ["embedded:spot"]
-materials = ["blue-acrylic"]
-size = 64
-views = 4
-lights = 12
-[run]
-seed = 3
-[run.model]
-width = 16
-[run.features.lbo]
-k_max = 32
-first = 16
-blocks = 1
-block_len = 8
-[run.train]
+/// The tortured sweep: one small scene, four models, snapshots, the NOL ablation.
+fn profile() -> String {
+    let head = "kill -9 torture: one small scene, four models, snapshots, the NOL ablation";
+    test_support::TinyProfile::new("torture", head, 3).scene(64, 4, 12).with(
+        r#"[run.train]
 profile = "quick"
 iterations = 200
 batch_size = 1024
@@ -59,7 +45,9 @@ reciprocity_pairs = 200
 models = ["rp", "disney", "single_mlp", "additive_shared_enhanced"]
 ablations = ["nol"]
 runtime_curve = true
-"#;
+"#,
+    )
+}
 
 /// The cheap torture of every CI run: one tiny scene, two models, the NOL ablation.
 fn tiny() -> String {
@@ -387,7 +375,7 @@ fn a_tiny_sweep_killed_five_times_resumes_to_the_same_results() {
 #[test]
 #[ignore = "minutes: cargo test -p xtask --test kill_torture -- --ignored --nocapture"]
 fn a_sweep_killed_at_random_moments_resumes_to_the_same_results() {
-    torture(PROFILE, "torture", kills(20));
+    torture(&profile(), "torture", kills(20));
 }
 
 /// Runs the sweep of `profile_text` once uninterrupted, then `kills` times killed at random
@@ -476,7 +464,7 @@ fn torture(profile_text: &str, label: &str, kills: usize) {
 fn a_full_disk_is_a_clear_error_and_keeps_the_previous_results() {
     let tmp = test_support::TempDir::new("fulldisk");
     let profile = tmp.0.join("torture.toml");
-    std::fs::write(&profile, PROFILE).unwrap();
+    std::fs::write(&profile, self::profile()).unwrap();
     let mount = tmp.0.join("disk");
     std::fs::create_dir_all(&mount).unwrap();
     let out = mount.join("out");

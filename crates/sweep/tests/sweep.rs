@@ -14,25 +14,11 @@ fn shared_data() -> Option<PathBuf> {
     support::shared_data_root("")
 }
 
-const PROFILE: &str = r#"
-name = "mini"
-description = "test"
-[data]
-meshes = ["data:meshes/spot.obj"]
-materials = ["blue-acrylic"]
-size = 24
-views = 2
-lights = 4
-[run]
-seed = 1
-[run.model]
-width = 16
-[run.features.lbo]
-k_max = 32
-first = 16
-blocks = 1
-block_len = 8
-[run.train]
+/// The miniature profile: Spot from the shared data (the `data:` mesh path), three models, the
+/// NOL ablation and the run-time curve.
+fn mini_profile() -> String {
+    support::TinyProfile::new("mini", "test", 1).mesh("data:meshes/spot.obj").with(
+        r#"[run.train]
 iterations = 12
 batch_size = 512
 warmup_steps = 2
@@ -47,7 +33,9 @@ reciprocity_pairs = 200
 models = ["single_mlp", "disney", "additive_shared_enhanced"]
 ablations = ["nol"]
 runtime_curve = true
-"#;
+"#,
+    )
+}
 
 #[test]
 fn a_miniature_sweep_produces_every_table_and_resumes() {
@@ -55,7 +43,7 @@ fn a_miniature_sweep_produces_every_table_and_resumes() {
     let tmp = test_support::TempDir::new("sweep");
     // A hostile output path: spaces, non-ASCII letters, a quote and an emoji (issue 19).
     let out = tmp.0.join("out dir/Ünïcødé it's ✓ 🌈");
-    let profile = SweepProfile::parse(PROFILE, "mini.toml").unwrap();
+    let profile = SweepProfile::parse(&mini_profile(), "mini.toml").unwrap();
     let s = sweep::sweep(&profile, &out, &data, &Execution::InProcess(Default::default())).unwrap();
     assert!(s.failed.is_empty(), "{:?}", s.failed);
     // 3 Table 1 runs (with snapshots: the run-time curve) + 1 NOL (single MLP: of the profile's
@@ -122,7 +110,7 @@ fn a_miniature_sweep_produces_every_table_and_resumes() {
     assert_eq!((again.completed, again.skipped, again.scenes_kept), (0, 4, 1));
     // A changed configuration is a new run; --emit-jobs lists exactly the unfinished one.
     let changed =
-        SweepProfile::parse(&PROFILE.replace("seed = 1", "seed = 2"), "mini2.toml").unwrap();
+        SweepProfile::parse(&mini_profile().replace("seed = 1", "seed = 2"), "mini2.toml").unwrap();
     let jobs = out.join("jobs.txt");
     let how = Execution::Emit { file: jobs.clone(), command: vec!["run-one".into()] };
     let e = sweep::sweep(&changed, &out, &data, &how).unwrap();
@@ -149,7 +137,7 @@ fn a_real_capture_sweep_gives_the_real_world_column() {
     let Some(data) = shared_data() else { return };
     let tmp = test_support::TempDir::new("real-sweep");
     let out = tmp.0.join("out");
-    let text = PROFILE
+    let text = mini_profile()
         .replace("ablations = [\"nol\"]\nruntime_curve = true\n", "")
         .replace("\"additive_shared_enhanced\"", "")
         .replace("lights = 4\n", "lights = 4\ncaptures = [\"diligent:ball\"]\n");

@@ -15,6 +15,6 @@ mod shared_data;
 mod temp_dir;
 
 pub use close::{assert_close, assert_close_scaled};
-pub use profile::tiny_profile;
+pub use profile::{TinyProfile, tiny_profile};
 pub use shared_data::{shared_data_root, shared_docs_root};
 pub use temp_dir::TempDir;
