@@ -5,7 +5,7 @@
 //! in blocks of about 512 KB of rows, each a single-threaded gemm followed by the bias add while
 //! the block is still in L2, the blocks in parallel. burn's default `linear` is the product and
 //! then a broadcast add, one more pass over the output read and written (16 MB each way for a
-//! [32768, 128] activation; 5 % of a bf16 Single MLP step in a `perf` profile). A row's value
+//! [32768, 128] activation, a visible share of a bf16 step in a `perf` profile). A row's value
 //! does not depend on the block it falls in (gemm sums every output over the same k blocks), so
 //! the result equals the whole-matrix gemm followed by the add, to the bit.
 //!

@@ -3,9 +3,8 @@
 //! A training step's weight gradients are `Xᵀ dY`: [d_in, batch] x [batch, d_out], an output
 //! of at most a few hundred squared summed over tens of thousands of samples. The gemm crate
 //! parallelises over the output's rows and columns only, so on such a product its threads
-//! share a 128 x 128 output and each streams the whole k: measured 121 to 136 GFLOP/s on
-//! [128, 32768]ᵀ x [32768, 128] on the 2-core bench machine against 163 to 173 for the same
-//! product summed in two halves, one thread each.
+//! share a 128 x 128 output and each streams the whole k, slower than the same product summed
+//! in two halves, one thread each (`benches/weight_gradient.rs` prints both rates).
 //!
 //! Here k is cut into a number of blocks that depends on k alone (not on the thread count, so
 //! that a product's value is the same on every machine): each block is one single-threaded
@@ -15,10 +14,10 @@
 //!
 //! The blocks are 2,048 long, at most 32 of them: a batch of 2^15 gives 16 blocks, one for
 //! every core of a 16-core workstation, where the earlier 4,096-long blocks (8 at 2^15) left
-//! half of the cores idle in every weight gradient (313 GFLOP/s against 972 for a 2048^3
-//! product on a lent 16-core machine). One thread's rate on a 2,048-long block is its rate on
-//! a 4,096-long one; 1,024-long blocks cost 2 to 4 % of it (`benches/weight_gradient.rs`
-//! prints the rates by block length), and the two-core step by about as much.
+//! half of the cores idle in every weight gradient. One thread's rate on a 2,048-long block is
+//! its rate on a 4,096-long one, and shorter blocks cost a few per cent of it
+//! (`benches/weight_gradient.rs` prints the rates by block length; figures in
+//! `benches/README.md`).
 
 use alloc::vec;
 use alloc::vec::Vec;

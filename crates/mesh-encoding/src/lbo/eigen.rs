@@ -76,7 +76,7 @@ pub struct EigenSettings {
     pub slice_size: usize,
     /// Threads for faer's dense kernels inside the solver: 1 (default) sequential, 0 faer's
     /// global setting, `t > 1` a rayon pool of `t`. Not part of the cache key (results differ
-    /// only by rounding). Sequential is the default because faer's rayon kernels were 3x slower
+    /// only by rounding). Sequential is the default because faer's rayon kernels were slower
     /// than sequential ones on a 2-core machine shared with other jobs (see `PERFORMANCE.md`).
     pub threads: usize,
 }

@@ -4,9 +4,9 @@
 //! faer's high-level `Llt::solve_in_place` allocates its whole workspace (an `n x b` temporary
 //! plus the supernodal scratch, megabytes) on every call and runs with faer's global
 //! parallelism. Block Lanczos calls it about a hundred times: the allocations showed up as
-//! system time and page faults (block solves took 10.7 s of a 21 s bunny solve on a quiet
-//! machine, 1.7 s in another run). This factor keeps one workspace, grown on demand, and
-//! solves with the solver's own parallelism setting.
+//! system time and page faults, half of a bunny solve on one machine (`PERFORMANCE.md`). This
+//! factor keeps one workspace, grown on demand, and solves with the solver's own parallelism
+//! setting.
 
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};

@@ -5,8 +5,7 @@
 //! With a single shift below the spectrum, the `k`-th eigenvalue is poorly separated in the
 //! shift-inverted operator (`theta = 1 / lambda`: the relative gap at the end of the wanted range
 //! is about `b / k`), so the basis must grow to several times `k` and the `O(n m^2)`
-//! orthogonalisation dominates (53 s for 513 pairs of the bunny). Slicing replaces one large
-//! basis by `S` small ones:
+//! orthogonalisation dominates. Slicing replaces one large basis by `S` small ones:
 //! 1. shifts `mu_1 < mu_2 < ...` spaced by about `slice_size` Weyl spacings (`4 pi / area`);
 //!    each `L - mu_s M` is factored as `LDL^T` (faer's supernodal factorisation without
 //!    pivoting, same symbolic analysis and AMD ordering for all shifts) and the number of
@@ -24,13 +23,10 @@
 //!
 //! Status: correct and complete by construction (exact counts); each slice runs the shared
 //! block Lanczos ([`super::lanczos`], same checkpoint scheduling, wanted pairs = largest
-//! `|theta|`). On the bunny at 513 pairs (sequential, busy machine, back to back) slices of 128
-//! took 10.7 s against 12.4-13.0 s for the single shift: the orthogonalisation shrinks
-//! (4.3 s against 7.4 s) but 5 extra factorisations and the global Rayleigh-Ritz over all
-//! slice vectors (about 3.5 s) eat most of the gain, and the residuals are larger (1e-7 against
-//! 2e-9, eigenvalues equal to 3e-13). Off by default (`EigenSettings::slice_size = 0`). The
-//! block-16 `LDL^T` solves took about 13 ms each; the 0.1 s seen earlier was faer's rayon
-//! kernels on an oversubscribed machine.
+//! `|theta|`). On the bunny the orthogonalisation shrinks, but the extra factorisations and the
+//! global Rayleigh-Ritz over all slice vectors eat most of the gain, and the residuals are
+//! larger (the eigenvalues agree to rounding; figures in the crate's `PERFORMANCE.md`). Off by
+//! default (`EigenSettings::slice_size = 0`).
 
 use std::time::Instant;
 

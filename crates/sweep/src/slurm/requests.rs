@@ -117,10 +117,9 @@ pub fn requests(
     let eval_s = 300.0 + scene_bytes as f64 / 1e6;
     let minutes = ((1.5 * (train_s + eval_s)) / 60.0).ceil() as u64;
     let minutes = minutes.clamp(10, s.max_minutes.unwrap_or(24 * 60).max(10));
-    // Measured (2026-12-02, the default profile's 88 MB scene, /usr/bin/time): a Single MLP
-    // run peaked at 416 MiB through training and evaluation, FMBRDF's training at 359 MiB,
-    // about 1.6 times the scene's bytes above a 150 MiB process. Asked: 1 GiB plus six times
-    // the scene's bytes.
+    // A run peaks at under twice the scene's bytes above the process's own footprint
+    // (`benches/README.md`, "Figures that left the source comments"). Asked: 1 GiB plus six
+    // times the scene's bytes.
     let mem_mib = s.mem_mib.unwrap_or(1024 + (6 * scene_bytes).div_ceil(1 << 20));
     Requests { cpus, mem_mib, minutes, gpu }
 }
