@@ -21,7 +21,7 @@
 //! -> 3.08 ms; FMBRDF 44 to 51 ms (its two helper networks run per sample).
 
 use brdf_neural::device;
-use brdf_neural::precision::MatmulPrecision;
+use brdf_neural::products::Products;
 use brdf_neural::tensor_brdf::Geometry;
 use brdf_neural::{BrdfModel, ModelConfig, ModelKind, ParametricModel};
 use burn::tensor::{Device, Tensor, TensorData};
@@ -82,7 +82,7 @@ impl Case {
             &self.device,
         )
         .require_grad();
-        let f = self.model.brdf_of_outputs(z.clone(), &self.geometry, MatmulPrecision::F32);
+        let f = self.model.brdf_of_outputs(z.clone(), &self.geometry, Products::F32);
         let loss = (f - self.target.clone()).square().mean();
         let grads = loss.backward();
         let g = z.grad(&grads).expect("gradient of the raw outputs");

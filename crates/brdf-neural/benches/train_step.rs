@@ -19,7 +19,8 @@
 //! - `BRDF_BENCH_MODELS=single_mlp,disney` times only these models (names as in the summary:
 //!   each kind's `config_name`);
 //!   `BRDF_BENCH_RATES=0` skips the gemm and product rates and prints nothing (for `perf`);
-//! - `BRDF_KEEP_MALLOC=0` turns the host-memory policy off (`brdf_neural::host_memory`);
+//! - `BRDF_KEEP_MALLOC=0` turns the host-memory policy off (`brdf_neural::host_memory`), and
+//!   `CPU_KERNELS_AMX=0` keeps the bf16 products off the AMX tiles, as on the command line;
 //! - `BRDF_BENCH_PRECISION=f32,bf16` (default `f32`) also times every step with bf16 matrix
 //!   products ([`brdf_neural::precision`], flex and cuda: tensor cores), with the PyTorch
 //!   comparison under bf16 autocast, and the flex products themselves in both precisions;
@@ -40,6 +41,7 @@
 use brdf_neural::batch_split;
 use brdf_neural::device::Backend;
 use brdf_neural::device::BackendDevice;
+use brdf_neural::gpu_linear::{GpuLinear, GpuTuning};
 use brdf_neural::mlp::MlpConfig;
 use brdf_neural::precision::MatmulPrecision;
 use brdf_neural::precision::PrecisionSupport;
@@ -132,7 +134,9 @@ impl Step {
         precision.check(backend).expect("precision on this backend");
         let batch =
             BrdfBatch::new(c, &Samples { spatial: &spatial, l: &l, v: &v }, None, device).unwrap();
-        let batch = batch.with_products(Products { precision, parts: split });
+        let products = Products { precision, parts: split, ..Products::F32 };
+        let products = products.with_bf16_amx(bench_bf16_amx()).with_gpu(bench_gpu_tuning());
+        let batch = batch.with_products(products);
         let weight = Tensor::random([n, 1], Distribution::Uniform(0.0, 3.0), device);
         let target = Tensor::random([n, 3], Distribution::Uniform(0.0, 1.0), device);
         Self {
@@ -310,7 +314,29 @@ fn pytorch_step(
         .ok_or_else(|| format!("{script}: {}", String::from_utf8_lossy(&out.stderr).trim()))
 }
 
+/// `CPU_KERNELS_AMX=0` keeps the bf16 products off the AMX tiles (as the command line's
+/// setting does, run-format's `ComputeSettings::bf16_amx`).
+fn bench_bf16_amx() -> bool {
+    std::env::var("CPU_KERNELS_AMX").map_or(true, |v| v.trim() != "0")
+}
+
+/// The GPU's linear layers as `NEURAL_BRDF_GPU_LINEAR`, `_SPLIT_LEN`, `_TILE` and `_CHECKED`
+/// say (model-spec's `GpuTuning`, as on the command line).
+fn bench_gpu_tuning() -> GpuTuning {
+    let mut tuning = GpuTuning::default();
+    for (var, _) in GpuTuning::VARIABLES {
+        if let Ok(value) = std::env::var(var) {
+            tuning = tuning.with_override(var, &value).expect("a GPU setting");
+        }
+    }
+    tuning
+}
+
 fn bench(cr: &mut Criterion) {
+    if std::env::var("BRDF_KEEP_MALLOC").is_ok_and(|v| v.trim() == "0") {
+        brdf_neural::host_memory::leave_allocator_alone();
+    }
+    brdf_neural::gpu_linear::launch_checked(bench_gpu_tuning().checked);
     let n = batch_size();
     let quick = std::env::var("BRDF_BENCH_QUICK").is_ok_and(|v| v != "0");
     let mut summary = Vec::new();
@@ -387,7 +413,7 @@ fn bench(cr: &mut Criterion) {
         rates.forward, rates.weight_grad, rates.weight_grad_split
     );
     if precisions().contains(&MatmulPrecision::Bf16) && backends().contains(&Backend::Flex) {
-        let r = flex_product_rates(n);
+        let r = flex_product_rates(n, bench_bf16_amx());
         println!(
             "flex products through burn (allocation included), f32 -> bf16 GFLOP/s: \
              [{n}, 128] x [128, 128] {:.1} -> {:.1} ({:.2}x); weight gradient {:.1} -> {:.1} \
@@ -406,9 +432,7 @@ fn bench(cr: &mut Criterion) {
             MatmulPrecision::bf16_on_amx()
         );
         if MatmulPrecision::bf16_on_amx() {
-            MatmulPrecision::set_bf16_amx_enabled(false);
-            let r = flex_product_rates(n);
-            MatmulPrecision::set_bf16_amx_enabled(true);
+            let r = flex_product_rates(n, false);
             println!(
                 "the same bf16 products on the AVX-512 kernel instead of AMX, GFLOP/s: forward \
                  {:.1}, weight gradient {:.1}, input gradient {:.1}",
@@ -432,8 +456,7 @@ fn bench(cr: &mut Criterion) {
     }
     if backends().into_iter().any(|b| b.is_gpu()) {
         // On a GPU whose layers run on gpu-kernels, `batch_split` leaves the layers whole.
-        use brdf_neural::gpu_linear::GpuLinear;
-        let layers = match GpuLinear::current() {
+        let layers = match bench_gpu_tuning().linear {
             GpuLinear::Ours => {
                 "on gpu-kernels, whose weight gradients split inside their kernel: the GPU \
                  rows' split column does not apply"
@@ -532,10 +555,11 @@ fn layer_products(backend: Backend, n: usize) {
     let (xt, wt) = (random([n, 128]), random([128, 128]));
     let bt = Tensor::<1>::random([128], Distribution::Uniform(-1.0, 1.0), &train).require_grad();
     let layer = || {
-        let f32 = MatmulPrecision::F32;
+        let f32 = Products::F32.with_gpu(bench_gpu_tuning());
         brdf_neural::linear_op::linear(xt.clone(), wt.clone(), Some(bt.clone()), f32)
     };
-    let which = if brdf_neural::linear_op::uses_gpu_kernels(&xt) { "gpu-kernels" } else { "burn" };
+    let ours = brdf_neural::linear_op::uses_gpu_kernels(&xt, bench_gpu_tuning().linear);
+    let which = if ours { "gpu-kernels" } else { "burn" };
     rows.push((format!("layer x W + b ({which})"), time_on(&train, &layer)));
     let backward = || {
         let grads = layer().sum().backward();
@@ -576,14 +600,15 @@ fn time_on(device: &Device, f: &dyn Fn() -> Tensor<2>) -> f64 {
 
 /// GFLOP/s (f32, bf16) of flex's products through burn tensors, best of 11: the forward
 /// [n, 128] x [128, 128], the weight gradient X^T dY and the input gradient dY W^T.
-fn flex_product_rates(n: usize) -> [(f64, f64); 3] {
+fn flex_product_rates(n: usize, bf16_amx: bool) -> [(f64, f64); 3] {
     let device = Backend::Flex.training_device().expect("flex");
     let x: Tensor<2> = Tensor::random([n, 128], Distribution::Uniform(-1.0, 1.0), &device);
     let dy: Tensor<2> = Tensor::random([n, 128], Distribution::Uniform(-1.0, 1.0), &device);
     let w: Tensor<2> = Tensor::random([128, 128], Distribution::Uniform(-1.0, 1.0), &device);
     let flops = 2.0 * (n * 128 * 128) as f64;
-    let rate = |p: MatmulPrecision, (a, b): (&Tensor<2>, &Tensor<2>)| {
-        p.check(Backend::Flex).expect("flex");
+    let rate = |precision: MatmulPrecision, (a, b): (&Tensor<2>, &Tensor<2>)| {
+        precision.check(Backend::Flex).expect("flex");
+        let p = Products { precision, ..Products::F32 }.with_bf16_amx(bf16_amx);
         let mut best = f64::INFINITY;
         for _ in 0..11 {
             let t = Instant::now();

@@ -35,19 +35,18 @@ pub fn gpu_parts(rows: usize) -> usize {
 }
 
 /// `layer` applied to `x` (`[rows, d_in]` to `[rows, d_out]`), split into
-/// [`Products::parts`]; unsplit, through [`crate::linear_op::linear`] in
-/// [`Products::precision`].
+/// [`Products::parts`]; unsplit, through [`crate::linear_op::linear`] with `products`.
 pub(crate) fn linear(layer: &Linear, x: Tensor<2>, products: Products) -> Tensor<2> {
     let parts = products.parts;
     let [rows, d_in] = x.dims();
     // The gpu-kernels split the weight gradients inside their own kernel.
-    let own_kernels = crate::linear_op::uses_gpu_kernels(&x);
+    let own_kernels = crate::linear_op::uses_gpu_kernels(&x, products.gpu.linear);
     if parts <= 1 || !rows.is_multiple_of(parts) || rows / parts < MIN_ROWS || own_kernels {
         // The weight first: lazily initialised parameters draw their values at their first
         // `val()`, in the order burn's `Linear::forward` reads them.
         let weight = layer.weight.val();
         let bias = layer.bias.as_ref().map(|b| b.val());
-        return crate::linear_op::linear(x, weight, bias, products.precision);
+        return crate::linear_op::linear(x, weight, bias, products);
     }
     let weight = layer.weight.val();
     let d_out = weight.dims()[1];

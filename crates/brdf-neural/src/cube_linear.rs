@@ -5,13 +5,15 @@
 //! The kernels take row-major f32 matrices: an operand with other strides is first made
 //! contiguous (burn's own kernel), and a tensor of another float type, or a shape past the
 //! kernels' grid limits, takes burn's own operations instead, so every input has an answer.
-//! A layer's products run in the precision the layer hands over: f32, or
+//! A layer's products run in the precision and on the tile and split length of the batch's
+//! products ([`Products`]): f32, or
 //! [`MatmulPrecision::Bf16`] on tensor cores (`gpu_kernels::gemm_cmma`; CUDA on Ampere or
 //! later; [`PrecisionSupport::check`](crate::precision::PrecisionSupport::check) refuses bf16
 //! on wgpu, whose WGSL has no such instructions). A CUDA device without them runs the products in f32, and says so once.
 
 use crate::linear_op::LinearKernels;
 use crate::precision::MatmulPrecision;
+use crate::products::Products;
 use burn::backend::ops::{ActivationOps, FloatTensorOps};
 use burn::backend::tensor::FloatTensor;
 use burn::tensor::{DType, Shape};
@@ -39,6 +41,11 @@ fn kernel_precision(client: &cubecl::prelude::Client, p: MatmulPrecision) -> Pre
             Precision::F32
         }
     }
+}
+
+/// The kernels' tile and split length of a batch's products.
+fn tuning(products: Products) -> kernels::Tuning {
+    crate::gpu_linear::kernel_tuning(products.gpu)
 }
 
 /// The tensor as a row-major matrix (made contiguous first where it is not), or `None` for a
@@ -79,12 +86,13 @@ impl LinearKernels for CubeBackend {
         x: FloatTensor<Self>,
         weight: FloatTensor<Self>,
         bias: FloatTensor<Self>,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> FloatTensor<Self> {
         if let (Some((xt, xm)), Some((_, wm)), Some((_, bm))) =
             (matrix(x.clone()), matrix(weight.clone()), matrix(row(bias.clone())))
-            && let p = kernel_precision(&xt.client, precision)
-            && let Ok(y) = kernels::forward(&xt.client, &xm, &wm, Some(&bm.handle), false, p)
+            && let p = kernel_precision(&xt.client, products.precision)
+            && let Ok(y) =
+                kernels::forward(&xt.client, &xm, &wm, Some(&bm.handle), false, p, tuning(products))
         {
             let shape = Shape::new([y.rows as usize, y.cols as usize]);
             return tensor(&xt, y, shape);
@@ -95,11 +103,11 @@ impl LinearKernels for CubeBackend {
     fn kernel_linear_no_bias(
         x: FloatTensor<Self>,
         weight: FloatTensor<Self>,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> FloatTensor<Self> {
         if let (Some((xt, xm)), Some((_, wm))) = (matrix(x.clone()), matrix(weight.clone()))
-            && let p = kernel_precision(&xt.client, precision)
-            && let Ok(y) = kernels::forward(&xt.client, &xm, &wm, None, false, p)
+            && let p = kernel_precision(&xt.client, products.precision)
+            && let Ok(y) = kernels::forward(&xt.client, &xm, &wm, None, false, p, tuning(products))
         {
             let shape = Shape::new([y.rows as usize, y.cols as usize]);
             return tensor(&xt, y, shape);
@@ -110,12 +118,12 @@ impl LinearKernels for CubeBackend {
     fn kernel_linear_x_backward(
         weight: FloatTensor<Self>,
         output_grad: FloatTensor<Self>,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> FloatTensor<Self> {
         if let (Some((_, wm)), Some((gt, gm))) =
             (matrix(weight.clone()), matrix(output_grad.clone()))
-            && let p = kernel_precision(&gt.client, precision)
-            && let Ok(dx) = kernels::x_backward(&gt.client, &wm, &gm, p)
+            && let p = kernel_precision(&gt.client, products.precision)
+            && let Ok(dx) = kernels::x_backward(&gt.client, &wm, &gm, p, tuning(products))
         {
             let shape = Shape::new([dx.rows as usize, dx.cols as usize]);
             return tensor(&gt, dx, shape);
@@ -126,11 +134,11 @@ impl LinearKernels for CubeBackend {
     fn kernel_linear_weight_backward(
         x: FloatTensor<Self>,
         output_grad: FloatTensor<Self>,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> FloatTensor<Self> {
         if let (Some((xt, xm)), Some((_, gm))) = (matrix(x.clone()), matrix(output_grad.clone()))
-            && let p = kernel_precision(&xt.client, precision)
-            && let Ok(dw) = kernels::weight_backward(&xt.client, &xm, &gm, p)
+            && let p = kernel_precision(&xt.client, products.precision)
+            && let Ok(dw) = kernels::weight_backward(&xt.client, &xm, &gm, p, tuning(products))
         {
             let shape = Shape::new([dw.rows as usize, dw.cols as usize]);
             return tensor(&xt, dw, shape);

@@ -106,7 +106,6 @@ impl BackendDevice for Backend {
             Backend::Wgpu => {
                 #[cfg(feature = "wgpu")]
                 {
-                    crate::gpu_linear::configure()?;
                     crate::gpu_cache::configure();
                     return Ok(Device::wgpu(Default::default()));
                 }
@@ -124,7 +123,6 @@ impl BackendDevice for Backend {
                                 .into(),
                         ));
                     }
-                    crate::gpu_linear::configure()?;
                     crate::gpu_cache::configure();
                     return Ok(Device::cuda(0usize));
                 }

@@ -12,14 +12,14 @@
 //! [`keep_freed_tensor_memory`] raises both thresholds once per process (`mallopt`), so freed
 //! buffers return to malloc's free lists and the next step reuses them. The price is that the
 //! process keeps its peak heap (about the memory of one training step) until it exits. It runs
-//! when a CPU device is first made through [`BackendDevice::device`](crate::device::BackendDevice::device)(crate::device::Backend::device)
-//! and does nothing on other C libraries (musl, macOS, Windows), whose allocators behave
-//! differently. `BRDF_KEEP_MALLOC=0` in the environment turns it off, for comparisons.
+//! when a CPU device is first made through
+//! [`BackendDevice::device`](crate::device::BackendDevice::device) and does nothing on other C
+//! libraries (musl, macOS, Windows), whose allocators behave differently. A command line that
+//! was told not to (`keep_freed_memory = false` in run-format's `ComputeSettings`,
+//! `BRDF_KEEP_MALLOC=0`) calls [`leave_allocator_alone`] first, for comparisons. The policy
+//! changes the speed only, never a value.
 
 use std::sync::Once;
-
-/// The environment variable that turns the policy off when set to `0`.
-pub const ENV_OFF: &str = "BRDF_KEEP_MALLOC";
 
 /// Whether [`keep_freed_tensor_memory`] changed the allocator's settings in this process.
 pub fn is_active() -> bool {
@@ -30,14 +30,17 @@ static ONCE: Once = Once::new();
 static ACTIVE: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
 /// Raises the C allocator's mmap and trim thresholds so that freed tensor buffers are reused
-/// (see the module docs). Idempotent; a no-op off glibc or with `BRDF_KEEP_MALLOC=0`.
+/// (see the module docs). Idempotent; a no-op off glibc or after [`leave_allocator_alone`].
 pub fn keep_freed_tensor_memory() {
     ONCE.call_once(|| {
-        if std::env::var(ENV_OFF).is_ok_and(|v| v.trim() == "0") {
-            return;
-        }
         ACTIVE.store(raise_thresholds(), std::sync::atomic::Ordering::Relaxed);
     });
+}
+
+/// Leaves the allocator's settings as they are for the rest of the process: a later
+/// [`keep_freed_tensor_memory`] does nothing. Without effect once the policy was applied.
+pub fn leave_allocator_alone() {
+    ONCE.call_once(|| {});
 }
 
 #[cfg(all(target_os = "linux", target_env = "gnu"))]
@@ -69,7 +72,8 @@ mod tests {
         let first = is_active();
         keep_freed_tensor_memory();
         assert_eq!(is_active(), first);
-        let off = std::env::var(ENV_OFF).is_ok_and(|v| v.trim() == "0");
-        assert_eq!(first, cfg!(all(target_os = "linux", target_env = "gnu")) && !off);
+        assert_eq!(first, cfg!(all(target_os = "linux", target_env = "gnu")));
+        leave_allocator_alone();
+        assert_eq!(is_active(), first, "too late to leave it alone");
     }
 }

@@ -11,42 +11,42 @@
 //! layer whose backward pass calls the backend's input-gradient and weight-gradient kernels and
 //! burn's bias gradient, the same three gradients as burn's own `linear`.
 //!
-//! The precision of the products ([`MatmulPrecision`]) is an argument of the operation, kept in
-//! the graph node for the backward pass: a bf16 training step computes its forward and backward
-//! products in bf16, and nothing else in the process changes precision.
+//! How the products are computed ([`Products`]: the precision, and for bf16 on the CPU whether
+//! AMX tiles are taken) is an argument of the operation, kept in the graph node for the
+//! backward pass: a bf16 training step computes its forward and backward products in bf16, and
+//! nothing else in the process changes precision.
 
-use crate::precision::MatmulPrecision;
+use crate::products::Products;
 use burn::tensor::Tensor;
 #[cfg(any(feature = "flex", feature = "wgpu", feature = "cuda"))]
 pub use kernels::LinearKernels;
 
-/// `x W + b` for x `[rows, d_in]`, W `[d_in, d_out]`, b `[d_out]`, its products in `precision`
-/// on the flex backend (f32 elsewhere:
+/// `x W + b` for x `[rows, d_in]`, W `[d_in, d_out]`, b `[d_out]`, its products as `products`
+/// says on the flex backend (f32 elsewhere:
 /// [`PrecisionSupport::check`](crate::precision::PrecisionSupport::check) refuses bf16 on
 /// other backends); burn's `linear` on every other backend.
 pub fn linear(
     x: Tensor<2>,
     weight: Tensor<2>,
     bias: Option<Tensor<1>>,
-    precision: MatmulPrecision,
+    products: Products,
 ) -> Tensor<2> {
     #[cfg(feature = "flex")]
     if x.device().inner() == burn::tensor::Device::flex() {
-        return kernels::linear(x, weight, bias, precision);
+        return kernels::linear(x, weight, bias, products);
     }
     #[cfg(any(feature = "wgpu", feature = "cuda"))]
-    if uses_gpu_kernels(&x) {
-        return kernels::linear(x, weight, bias, precision);
+    if uses_gpu_kernels(&x, products.gpu.linear) {
+        return kernels::linear(x, weight, bias, products);
     }
-    let _ = precision;
+    let _ = products;
     burn::tensor::module::linear(x, weight, bias)
 }
 
 /// Whether `x` is on a GPU (CubeCL) device whose linear layers run on this workspace's
-/// `gpu-kernels` ([`crate::gpu_linear`], `NEURAL_BRDF_GPU_LINEAR=ours`).
-pub fn uses_gpu_kernels(x: &Tensor<2>) -> bool {
-    crate::gpu_linear::GpuLinear::current() == crate::gpu_linear::GpuLinear::Ours
-        && crate::device::on_gpu(x)
+/// `gpu-kernels` when a batch's products ask for `linear` ([`crate::gpu_linear`]).
+pub fn uses_gpu_kernels(x: &Tensor<2>, linear: crate::gpu_linear::GpuLinear) -> bool {
+    linear == crate::gpu_linear::GpuLinear::Ours && crate::device::on_gpu(x)
 }
 
 /// `max(x, 0)`, its backward pass on this workspace's kernels on the flex backend (the mask

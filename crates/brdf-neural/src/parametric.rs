@@ -15,7 +15,6 @@
 
 use crate::mlp::Mlp;
 use crate::output::BrdfOutput;
-use crate::precision::MatmulPrecision;
 use crate::products::Products;
 use crate::tensor_brdf::{
     DisneyTensorParams, FmbrdfNets, FmbrdfTensorParams, Geometry, PhongTensorParams,
@@ -206,7 +205,7 @@ impl ParametricModel {
         products: Products,
     ) -> BrdfOutput {
         let z = self.mlp.forward(spatial, None, products);
-        let f = self.brdf_of_outputs(z, geometry, products.precision);
+        let f = self.brdf_of_outputs(z, geometry, products);
         BrdfOutput { f, diffuse: None, specular: None, xi: None }
     }
 
@@ -220,14 +219,14 @@ impl ParametricModel {
         &self,
         z: Tensor<2>,
         geometry: &Geometry,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> Tensor<2> {
         match self.params_of_outputs(z) {
             BrdfParams::RealisticPhong(p) => realistic_phong(&p, geometry),
             BrdfParams::TorranceSparrow(p) => torrance_sparrow(&p, geometry),
             BrdfParams::Disney(p) => disney(&p, geometry),
             BrdfParams::Fmbrdf(p) => {
-                fmbrdf(&p, self.fm_nets.as_ref().expect("FMBRDF nets"), geometry, precision)
+                fmbrdf(&p, self.fm_nets.as_ref().expect("FMBRDF nets"), geometry, products)
             }
         }
     }

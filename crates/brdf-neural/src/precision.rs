@@ -10,7 +10,8 @@
 //! tensor cores (`gpu-kernels`' `gemm_cmma`), PyTorch's bf16 autocast for the linear layers.
 //! The flex and cuda backends implement it; the others refuse it.
 //!
-//! The precision is part of a batch's [`crate::products::Products`]: a training loop's step
+//! The precision is part of a batch's [`crate::products::Products`], with the choice of the
+//! bf16 kernel (AMX tiles where available, or AVX512-BF16): a training loop's step
 //! batches carry the run's precision, every other batch (the validation loss, which decides
 //! the plateau schedule, and every evaluation) plain f32. The layers hand it to the kernels as
 //! an argument of each product ([`crate::linear_op`]), which keep it for the product's
@@ -27,8 +28,8 @@ pub trait PrecisionSupport {
     ///
     /// # Errors
     /// [`crate::Error::Spec`] (an invalid configuration) for bf16 on a backend other than flex
-    /// and cuda, and on cuda with burn's kernels for the linear layers
-    /// (`NEURAL_BRDF_GPU_LINEAR=burn`, [`crate::gpu_linear`]).
+    /// and cuda (on cuda with this workspace's kernels for the linear layers, the default;
+    /// [`crate::products::Products::check`] also refuses burn's there).
     fn check(self, backend: crate::device::Backend) -> crate::Result<()>;
 
     /// Whether this CPU has Intel's AMX-BF16 tile unit (Xeons from Sapphire Rapids on; CPUID
@@ -38,13 +39,10 @@ pub trait PrecisionSupport {
     /// Xeon with AMX"), and the trainer warns.
     fn cpu_has_amx_bf16() -> bool;
 
-    /// Whether the bf16 products run on AMX tiles here (the flex backend's AMX kernel: the CPU
-    /// has AMX-BF16 and Linux granted the tile registers; `CPU_KERNELS_AMX=0` turns it off).
+    /// Whether bf16 products that ask for AMX tiles ([`crate::products::Products::bf16_amx`])
+    /// run on them here (the flex backend's AMX kernel: the CPU has AMX-BF16 and Linux granted
+    /// the tile registers).
     fn bf16_on_amx() -> bool;
-
-    /// Lets the bf16 products use AMX tiles where available (the default) or keeps them on the
-    /// AVX-512 kernel, process-wide: for benchmarks and tests that compare the two.
-    fn set_bf16_amx_enabled(enabled: bool);
 
     /// Whether this CPU runs bf16 products natively (otherwise they are emulated, slowly).
     fn bf16_native() -> bool;
@@ -53,18 +51,12 @@ pub trait PrecisionSupport {
 impl PrecisionSupport for MatmulPrecision {
     fn check(self, backend: crate::device::Backend) -> crate::Result<()> {
         use crate::device::Backend;
-        use crate::gpu_linear::GpuLinear;
         if self == MatmulPrecision::F32 {
             return Ok(());
         }
         let refused = match backend {
             Backend::Flex => None,
-            Backend::Cuda if GpuLinear::current() == GpuLinear::Ours => None,
-            Backend::Cuda => Some(format!(
-                "matmul precision bf16 on cuda runs on this workspace's GPU kernels, not burn's \
-                 ({}=burn): unset it",
-                crate::gpu_linear::VAR
-            )),
+            Backend::Cuda => None,
             Backend::Wgpu => Some(
                 "matmul precision bf16 needs tensor cores, which wgpu's shading language (WGSL) \
                  cannot reach: on an NVIDIA GPU use --backend cuda (Ampere or later), or train \
@@ -98,19 +90,12 @@ impl PrecisionSupport for MatmulPrecision {
     fn bf16_on_amx() -> bool {
         #[cfg(feature = "flex")]
         {
-            cpu_kernels::bf16_amx_active()
+            cpu_kernels::bf16_amx_available()
         }
         #[cfg(not(feature = "flex"))]
         {
             false
         }
-    }
-
-    fn set_bf16_amx_enabled(enabled: bool) {
-        #[cfg(feature = "flex")]
-        cpu_kernels::set_bf16_amx_enabled(enabled);
-        #[cfg(not(feature = "flex"))]
-        let _ = enabled;
     }
 
     fn bf16_native() -> bool {

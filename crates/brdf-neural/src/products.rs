@@ -1,6 +1,7 @@
-//! How a batch's linear layers compute their matrix products: in which precision, and with
-//! the batch split into how many parts for the weight gradients. A value carried by the batch
-//! ([`crate::BrdfBatch::products`]), never a per-thread or per-process switch, so a product's
+//! How a batch's linear layers compute their matrix products: in which precision, on which
+//! bf16 kernel, and with the batch split into how many parts for the weight gradients. A value
+//! carried by the batch ([`crate::BrdfBatch::products`]) and handed to every product as an
+//! argument ([`crate::linear_op`]), never a per-thread or per-process switch, so a product's
 //! inputs say everything that decides its value.
 //!
 //! A batch starts as [`Products::F32`], the plain f32 product (every evaluation, the
@@ -11,6 +12,7 @@
 
 use crate::batch_split::gpu_parts;
 use crate::device::Backend;
+use crate::gpu_linear::{GpuLinear, GpuTuning};
 use crate::precision::{MatmulPrecision, PrecisionSupport};
 
 /// The precision and the batch split of a batch's linear layers.
@@ -21,6 +23,13 @@ pub struct Products {
     /// Parts of the batch whose weight-gradient sums are split (1: the plain product;
     /// [`crate::batch_split`]).
     pub parts: usize,
+    /// Whether bf16 products on the CPU take Intel's AMX tiles where the CPU and the OS allow
+    /// them ([`PrecisionSupport::bf16_on_amx`]; default true), or the AVX512-BF16 kernel. The
+    /// two sum in different orders: their values differ in the last bits.
+    pub bf16_amx: bool,
+    /// How the linear layers run on a GPU: which kernels, their tile and split length
+    /// ([`crate::gpu_linear`]; default: this workspace's kernels with their own rules).
+    pub gpu: GpuTuning,
 }
 
 impl Default for Products {
@@ -31,10 +40,32 @@ impl Default for Products {
 
 impl Products {
     /// Plain f32 products, unsplit.
-    pub const F32: Products = Products { precision: MatmulPrecision::F32, parts: 1 };
+    pub const F32: Products = Products {
+        precision: MatmulPrecision::F32,
+        parts: 1,
+        bf16_amx: true,
+        gpu: GpuTuning {
+            linear: GpuLinear::Ours,
+            split_len: None,
+            tile: crate::gpu_linear::GpuTile::T64,
+            checked: false,
+        },
+    };
+
+    /// These products with bf16 on AMX tiles where available (`true`) or on the AVX512-BF16
+    /// kernel (`false`).
+    pub fn with_bf16_amx(self, bf16_amx: bool) -> Products {
+        Products { bf16_amx, ..self }
+    }
+
+    /// These products with the GPU's linear layers on `gpu`.
+    pub fn with_gpu(self, gpu: GpuTuning) -> Products {
+        Products { gpu, ..self }
+    }
 
     /// The products of a training step of `batch_rows` samples on `backend`: `precision`,
-    /// and on a GPU the split of [`gpu_parts`] (the CPU keeps the plain product).
+    /// and on a GPU the split of [`gpu_parts`] (the CPU keeps the plain product), on the
+    /// default GPU kernels ([`Products::with_gpu`] picks others).
     ///
     /// # Errors
     /// [`crate::Error::Spec`] where `backend` cannot run `precision`
@@ -46,13 +77,35 @@ impl Products {
     ) -> crate::Result<Products> {
         precision.check(backend)?;
         let parts = if backend.is_gpu() { gpu_parts(batch_rows) } else { 1 };
-        Ok(Products { precision, parts })
+        Ok(Products { precision, parts, ..Products::F32 })
+    }
+
+    /// Refuses products that `backend` cannot run: bf16 where no kernel implements it
+    /// ([`PrecisionSupport::check`]), and bf16 on cuda with burn's kernels for the linear
+    /// layers, which have no bf16 path.
+    ///
+    /// # Errors
+    /// [`crate::Error::Spec`], saying what to change.
+    pub fn check(&self, backend: Backend) -> crate::Result<()> {
+        self.precision.check(backend)?;
+        if self.precision == MatmulPrecision::Bf16
+            && backend == Backend::Cuda
+            && self.gpu.linear == GpuLinear::Burn
+        {
+            return Err(model_spec::Error::InvalidConfig(
+                "matmul precision bf16 on cuda runs on this workspace's GPU kernels, not burn's \
+                 (NEURAL_BRDF_GPU_LINEAR=burn): unset it"
+                    .into(),
+            )
+            .into());
+        }
+        Ok(())
     }
 
     /// The products of an inference pass of `rows` samples: f32, split as a training step on
     /// a GPU would split them (`gpu`), unsplit on the CPU.
     pub fn inference(gpu: bool, rows: usize) -> Products {
-        Products { precision: MatmulPrecision::F32, parts: if gpu { gpu_parts(rows) } else { 1 } }
+        Products { parts: if gpu { gpu_parts(rows) } else { 1 }, ..Products::F32 }
     }
 }
 
@@ -63,12 +116,19 @@ mod tests {
     #[test]
     fn training_splits_only_on_a_gpu_and_checks_the_precision() {
         let cpu = Products::training(MatmulPrecision::Bf16, Backend::Flex, 32_768).unwrap();
-        assert_eq!(cpu, Products { precision: MatmulPrecision::Bf16, parts: 1 });
+        assert_eq!(cpu, Products { precision: MatmulPrecision::Bf16, ..Products::F32 });
+        assert!(!cpu.with_bf16_amx(false).bf16_amx);
         let gpu = Products::training(MatmulPrecision::F32, Backend::Wgpu, 32_768).unwrap();
-        assert_eq!(gpu, Products { precision: MatmulPrecision::F32, parts: 64 });
+        assert_eq!(gpu, Products { parts: 64, ..Products::F32 });
+        assert_eq!(Products::F32.gpu, GpuTuning::default());
         assert!(Products::training(MatmulPrecision::Bf16, Backend::Wgpu, 32_768).is_err());
         assert_eq!(Products::inference(false, 32_768), Products::F32);
         assert_eq!(Products::inference(true, 8_192).parts, 16);
         assert_eq!(Products::default(), Products::F32);
+        let cuda = Products::training(MatmulPrecision::Bf16, Backend::Cuda, 32_768).unwrap();
+        assert!(cuda.check(Backend::Cuda).is_ok());
+        let burn = cuda.with_gpu(GpuTuning { linear: GpuLinear::Burn, ..Default::default() });
+        let e = burn.check(Backend::Cuda).unwrap_err().to_string();
+        assert!(e.contains("burn"), "{e}");
     }
 }

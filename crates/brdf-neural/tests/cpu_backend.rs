@@ -85,9 +85,8 @@ fn matrix_product_gradients_match_f64() {
 #[test]
 fn host_memory_policy_is_active_after_making_a_cpu_device() {
     let _ = device::cpu();
-    let off = std::env::var(brdf_neural::host_memory::ENV_OFF).is_ok_and(|v| v.trim() == "0");
     let glibc = cfg!(all(target_os = "linux", target_env = "gnu"));
-    assert_eq!(brdf_neural::host_memory::is_active(), glibc && !off);
+    assert_eq!(brdf_neural::host_memory::is_active(), glibc);
 }
 
 /// `f` run on a rayon pool of `threads` threads (flex's products and element-wise ops use the
@@ -110,7 +109,7 @@ fn long_products_split_over_k_match_f64_and_not_the_thread_count() {
         let product = || {
             let tx = Tensor::<2>::from_data(TensorData::new(x.clone(), [k, m]), &d);
             let tdy = Tensor::<2>::from_data(TensorData::new(dy.clone(), [k, n]), &d);
-            let f32 = brdf_neural::precision::MatmulPrecision::F32;
+            let f32 = brdf_neural::products::Products::F32;
             let y = brdf_neural::linear_op::linear(tx.transpose(), tdy, None, f32);
             y.into_data().try_to_vec::<f32>().unwrap()
         };
@@ -129,7 +128,6 @@ fn element_wise_ops_on_every_thread_equal_the_scalar_ops() {
     // gradient (`cpu_kernels::elementwise::sum_rows`, blocks of rows). W is the identity, so
     // the layer is z + b exactly.
     use brdf_neural::linear_op;
-    use brdf_neural::precision::MatmulPrecision;
     let d = device::cpu_training();
     let (rows, cols) = (9_001, 37);
     let z = values(rows * cols, 11);
@@ -142,7 +140,8 @@ fn element_wise_ops_on_every_thread_equal_the_scalar_ops() {
         let tw = Tensor::<2>::from_data(TensorData::new(eye.clone(), [cols, cols]), &d);
         let tb = Tensor::<1>::from_data(TensorData::new(b.clone(), [cols]), &d).require_grad();
         let tg = Tensor::<2>::from_data(TensorData::new(g.clone(), [rows, cols]), &d);
-        let layer = linear_op::linear(tz, tw, Some(tb.clone()), MatmulPrecision::F32);
+        let layer =
+            linear_op::linear(tz, tw, Some(tb.clone()), brdf_neural::products::Products::F32);
         let y = linear_op::relu(layer);
         let grads = (y.clone() * tg).sum().backward();
         let gb = tb.grad(&grads).unwrap().into_data().try_to_vec::<f32>().unwrap();

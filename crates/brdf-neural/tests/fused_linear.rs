@@ -13,6 +13,7 @@ use brdf_neural::device::{self, Backend};
 use brdf_neural::linear_op::linear;
 use brdf_neural::precision::MatmulPrecision;
 use brdf_neural::precision::PrecisionSupport;
+use brdf_neural::products::Products;
 use burn::tensor::{Tensor, TensorData};
 
 /// Deterministic values in [-1, 1).
@@ -60,7 +61,7 @@ fn assert_same_bits(got: &[u32], want: &[u32], what: &str) {
 fn fused_and_plain(
     (m, k, n): (usize, usize, usize),
     seed: u64,
-    p: MatmulPrecision,
+    p: Products,
 ) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
     let d = device::cpu();
     let x = Tensor::<2>::from_data(TensorData::new(values(m * k, seed), [m, k]), &d);
@@ -75,7 +76,7 @@ fn fused_and_plain(
 #[test]
 fn f32_linear_layers_equal_the_product_plus_the_bias_to_the_bit() {
     for (i, &(m, k, n)) in SHAPES.iter().enumerate() {
-        let (fused, plain, flex) = fused_and_plain((m, k, n), 10 * i as u64, MatmulPrecision::F32);
+        let (fused, plain, flex) = fused_and_plain((m, k, n), 10 * i as u64, Products::F32);
         assert_same_bits(&fused, &plain, &format!("[{m}, {k}] x [{k}, {n}] + b"));
         assert_same_bits(&fused, &flex, &format!("[{m}, {k}] x [{k}, {n}] + b against flex"));
     }
@@ -85,17 +86,16 @@ fn f32_linear_layers_equal_the_product_plus_the_bias_to_the_bit() {
 fn bf16_linear_layers_equal_the_product_plus_the_bias_to_the_bit() {
     let kernels = if MatmulPrecision::bf16_on_amx() { vec![true, false] } else { vec![false] };
     for amx in kernels {
-        // Process-wide; the other tests here run f32, which no bf16 kernel touches.
-        MatmulPrecision::set_bf16_amx_enabled(amx);
         MatmulPrecision::Bf16.check(Backend::Flex).unwrap();
+        let bf16 =
+            Products { precision: MatmulPrecision::Bf16, ..Products::F32 }.with_bf16_amx(amx);
         for (i, &(m, k, n)) in SHAPES.iter().enumerate() {
             let seed = 100 + 10 * i as u64;
-            let (fused, plain, _) = fused_and_plain((m, k, n), seed, MatmulPrecision::Bf16);
+            let (fused, plain, _) = fused_and_plain((m, k, n), seed, bf16);
             let what = format!("bf16 (AMX: {amx}) [{m}, {k}] x [{k}, {n}] + b");
             assert_same_bits(&fused, &plain, &what);
         }
     }
-    MatmulPrecision::set_bf16_amx_enabled(true);
 }
 
 #[test]
@@ -110,7 +110,7 @@ fn linear_layer_gradients_equal_the_unfused_gradients_to_the_bit() {
             Tensor::<2>::from_data(TensorData::new(values(k * n, 2), [k, n]), &d).require_grad();
         let b = Tensor::<1>::from_data(TensorData::new(values(n, 3), [n]), &d).require_grad();
         let y = if fused {
-            linear(x.clone(), w.clone(), Some(b.clone()), MatmulPrecision::F32)
+            linear(x.clone(), w.clone(), Some(b.clone()), Products::F32)
         } else {
             x.clone().matmul(w.clone()) + b.clone().unsqueeze::<2>()
         };

@@ -113,9 +113,9 @@ fn loss_curves(
     let gpu_device = gpu().training_device().unwrap();
     let model = BrdfModel::init_seeded(c, &cpu, init, None).unwrap();
     let on_gpu = model.clone().fork(&gpu_device);
-    let on_cpu = Products { precision, parts: 1 };
+    let on_cpu = Products { precision, parts: 1, ..Products::F32 };
     let (_, l_cpu) = train_with(model, c, data, (30, 3e-3), &cpu, on_cpu);
-    let on_gpu_products = Products { precision, parts };
+    let on_gpu_products = Products { precision, parts, ..Products::F32 };
     let (trained, l_gpu) = train_with(on_gpu, c, data, (30, 3e-3), &gpu_device, on_gpu_products);
     assert!(l_cpu[29] < 0.5 * l_cpu[0], "the CPU fit learns: {l_cpu:?}");
     (l_cpu, l_gpu, trained)
@@ -160,16 +160,17 @@ fn bf16_trains_along_the_cpus_bf16_curve_or_is_refused() {
     assert_close_scaled("bf16 loss curve", &l_gpu, &l_cpu, 1e-2);
 }
 
-/// The linear layers take the kernels `NEURAL_BRDF_GPU_LINEAR` names: `gpu-kernels` for
-/// `ours` on a GPU tensor, burn's otherwise, and never ours on a CPU tensor.
+/// The linear layers take the kernels a batch's products name: `gpu-kernels` for `Ours` on a
+/// GPU tensor, burn's for `Burn`, and never ours on a CPU tensor.
 #[test]
-fn the_linear_layers_take_the_kernels_the_setting_names() {
+fn the_linear_layers_take_the_kernels_the_products_name() {
     use brdf_neural::gpu_linear::GpuLinear;
-    let ours = GpuLinear::from_env().unwrap() == GpuLinear::Ours;
+    use brdf_neural::linear_op::uses_gpu_kernels;
     let on_gpu = Tensor::<2>::zeros([4, 3], &gpu().device().unwrap());
     let on_cpu = Tensor::<2>::zeros([4, 3], &brdf_neural::device::cpu());
-    assert_eq!(brdf_neural::linear_op::uses_gpu_kernels(&on_gpu), ours);
-    assert!(!brdf_neural::linear_op::uses_gpu_kernels(&on_cpu));
+    assert!(uses_gpu_kernels(&on_gpu, GpuLinear::Ours));
+    assert!(!uses_gpu_kernels(&on_gpu, GpuLinear::Burn));
+    assert!(!uses_gpu_kernels(&on_cpu, GpuLinear::Ours));
 }
 
 #[test]

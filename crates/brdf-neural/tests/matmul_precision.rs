@@ -11,6 +11,7 @@ use brdf_neural::device::Backend;
 use brdf_neural::device::BackendDevice;
 use brdf_neural::precision::MatmulPrecision;
 use brdf_neural::precision::PrecisionSupport;
+use brdf_neural::products::Products;
 use burn::tensor::{Tensor, TensorData};
 
 fn rng(seed: u64) -> impl FnMut() -> f32 {
@@ -67,7 +68,7 @@ fn product(
     b: &[f32],
     (m, k, n): (usize, usize, usize),
     layout: Layout,
-    precision: MatmulPrecision,
+    products: Products,
 ) -> Vec<f32> {
     let device = Backend::Flex.device().unwrap();
     let transpose = |v: &[f32], r: usize, c: usize| {
@@ -92,7 +93,7 @@ fn product(
         _ => Tensor::from_data(TensorData::new(b.to_vec(), [k, n]), &device),
     };
     // A linear layer without bias: the products the models' layers issue.
-    brdf_neural::linear_op::linear(lhs, rhs, None, precision)
+    brdf_neural::linear_op::linear(lhs, rhs, None, products)
         .into_data()
         .try_to_vec::<f32>()
         .unwrap()
@@ -126,12 +127,13 @@ fn kernels() -> Vec<bool> {
 #[test]
 fn bf16_products_equal_the_rounded_operands_product() {
     for amx in kernels() {
-        // Process-wide; the other tests here are indifferent to which bf16 kernel runs.
-        MatmulPrecision::set_bf16_amx_enabled(amx);
-        assert_eq!(MatmulPrecision::bf16_on_amx(), amx);
         check_bf16_products(amx);
     }
-    MatmulPrecision::set_bf16_amx_enabled(true);
+}
+
+/// bf16 products, on AMX tiles where available (`amx`) or on the AVX512-BF16 kernel.
+fn bf16_products(amx: bool) -> Products {
+    Products { precision: MatmulPrecision::Bf16, ..Products::F32 }.with_bf16_amx(amx)
 }
 
 fn check_bf16_products(amx: bool) {
@@ -140,7 +142,7 @@ fn check_bf16_products(amx: bool) {
             let mut r = rng(si as u64 * 3 + layout as u64);
             let a: Vec<f32> = (0..m * k).map(|_| r()).collect();
             let b: Vec<f32> = (0..k * n).map(|_| r()).collect();
-            let got = product(&a, &b, (m, k, n), layout, MatmulPrecision::Bf16);
+            let got = product(&a, &b, (m, k, n), layout, bf16_products(amx));
             let (want, scale) = reference(&a, &b, m, k, n, bf16);
             let err = max_scaled_error(&got, &want, &scale);
             // f32 sums of k terms: a few ulp of the sum of magnitudes.
@@ -167,14 +169,14 @@ fn f32_is_plain_f32_and_bf16_the_rounded_product_on_any_thread() {
     let b: Vec<f32> = (0..k * n).map(|_| r()).collect();
     let (exact, scale) = reference(&a, &b, m, k, n, |x| x as f64);
     let (rounded, _) = reference(&a, &b, m, k, n, bf16);
-    let plain = product(&a, &b, (m, k, n), Layout::RowMajor, MatmulPrecision::F32);
+    let plain = product(&a, &b, (m, k, n), Layout::RowMajor, Products::F32);
     assert!(max_scaled_error(&plain, &exact, &scale) < 1e-5, "f32 is not the plain product");
-    let bf = product(&a, &b, (m, k, n), Layout::RowMajor, MatmulPrecision::Bf16);
+    let bf = product(&a, &b, (m, k, n), Layout::RowMajor, bf16_products(true));
     assert!(max_scaled_error(&bf, &rounded, &scale) < 1e-5, "bf16 is not the rounded product");
     // The same on another thread: nothing of a product's precision lives in the thread.
     let (a2, b2) = (a.clone(), b.clone());
     let other = std::thread::spawn(move || {
-        product(&a2, &b2, (m, k, n), Layout::RowMajor, MatmulPrecision::Bf16)
+        product(&a2, &b2, (m, k, n), Layout::RowMajor, bf16_products(true))
     })
     .join()
     .unwrap();
@@ -185,7 +187,6 @@ fn f32_is_plain_f32_and_bf16_the_rounded_product_on_any_thread() {
 /// model's output without changing the next f32 batch's.
 #[test]
 fn a_batch_carries_its_products() {
-    use brdf_neural::products::Products;
     use brdf_neural::{BrdfBatch, BrdfModel, ModelConfig, ModelKind, Samples};
     let device = Backend::Flex.device().unwrap();
     let c = ModelConfig { kind: ModelKind::SingleMlp, spatial_dim: 8, ..ModelConfig::default() };
@@ -232,7 +233,7 @@ fn narrow_and_small_products_stay_f32_under_bf16() {
         let mut r = rng(7);
         let a: Vec<f32> = (0..m * k).map(|_| r()).collect();
         let b: Vec<f32> = (0..k * n).map(|_| r()).collect();
-        let got = product(&a, &b, (m, k, n), Layout::RowMajor, MatmulPrecision::Bf16);
+        let got = product(&a, &b, (m, k, n), Layout::RowMajor, bf16_products(true));
         let (exact, scale) = reference(&a, &b, m, k, n, |x| x as f64);
         assert!(max_scaled_error(&got, &exact, &scale) < 1e-5, "{m}x{k}x{n}");
     }
@@ -249,8 +250,6 @@ fn bf16_is_refused_where_no_kernel_implements_it() {
     assert!(e.contains("--backend cuda") && e.contains("tensor cores"), "{e}");
     assert!(MatmulPrecision::Bf16.check(Backend::Flex).is_ok());
     // On cuda, the gpu-kernels' tensor-core products (the default kernels) implement it.
-    if std::env::var(brdf_neural::gpu_linear::VAR).is_err() {
-        assert!(MatmulPrecision::Bf16.check(Backend::Cuda).is_ok());
-    }
+    assert!(MatmulPrecision::Bf16.check(Backend::Cuda).is_ok());
     assert!(MatmulPrecision::F32.check(Backend::Wgpu).is_ok());
 }

@@ -198,7 +198,7 @@ fn fmbrdf_agrees_with_scalar() {
         let c = values(fmbrdf_normalization(p.alpha.clone(), p.beta.clone(), &device))[0];
         let c_ref = base.normalization();
         assert!((c - c_ref).abs() <= 1e-5 * c_ref, "c({alpha}, {beta}): {c} vs {c_ref}");
-        let f = fmbrdf(&p, &nets, &g, brdf_neural::precision::MatmulPrecision::F32);
+        let f = fmbrdf(&p, &nets, &g, brdf_neural::products::Products::F32);
         assert_agree(&format!("FMBRDF alpha {alpha} beta {beta}"), f, &expect);
     }
 }

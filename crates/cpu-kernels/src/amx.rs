@@ -17,10 +17,11 @@
 //! their valid part is copied out.
 //!
 //! Linux gives a process the tile registers only on request (`arch_prctl(ARCH_REQ_XCOMP_PERM,
-//! XFEATURE_XTILEDATA)`); [`amx_active`] asks once and answers false when the CPU lacks AMX-TILE
-//! or AMX-BF16, when the request fails, or when `CPU_KERNELS_AMX=0` is set (to measure the
-//! AVX-512 kernel on the same machine; [`set_amx_enabled`] does the same from code). Every
-//! task configures the tiles on its own thread and releases them when it is done.
+//! XFEATURE_XTILEDATA)`); [`amx_available`] asks once and answers false when the CPU lacks
+//! AMX-TILE or AMX-BF16 or when the request fails. Whether a product takes the tiles where they
+//! are available is the caller's, an argument of the product ([`crate::Precision::Bf16`]'s
+//! `amx`), never a process-wide switch. Every task configures the tiles on its own thread and
+//! releases them when it is done.
 
 use crate::bf16dot::MatRef;
 use crate::bf16dot::pair_bits;
@@ -40,24 +41,14 @@ const KC_PAIRS: usize = 512;
 /// Blocks of rows per parallel task (one tile configuration each).
 const BLOCKS_PER_TASK: usize = 8;
 
-static DISABLED: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
-
-/// Whether f32 products in bf16 precision run on AMX tiles in this process.
-pub fn amx_active() -> bool {
+/// Whether this process can run bf16 products on AMX tiles: the CPU has AMX-TILE and
+/// AMX-BF16 and Linux granted the tile registers (asked once, on first use).
+pub fn amx_available() -> bool {
     static AVAILABLE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    !DISABLED.load(core::sync::atomic::Ordering::Relaxed) && *AVAILABLE.get_or_init(detect)
-}
-
-/// Turns the AMX path off (or back on, where available) for the whole process: the products
-/// then run on the AVX-512 kernel. For tests and benchmarks that compare the two kernels.
-pub fn set_amx_enabled(enabled: bool) {
-    DISABLED.store(!enabled, core::sync::atomic::Ordering::Relaxed);
+    *AVAILABLE.get_or_init(detect)
 }
 
 fn detect() -> bool {
-    if std::env::var("CPU_KERNELS_AMX").is_ok_and(|v| v.trim() == "0") {
-        return false;
-    }
     if !crate::bf16dot::bf16_dot_native() || __cpuid(0).eax < 7 {
         return false;
     }
@@ -109,7 +100,7 @@ struct Tiles;
 
 impl Tiles {
     fn configure() -> Tiles {
-        // SAFETY: only called once `amx_active()` said the CPU and the OS allow tiles.
+        // SAFETY: only called once `amx_available()` said the CPU and the OS allow tiles.
         unsafe { asm!("ldtilecfg [{}]", in(reg) TILE_CONFIG.0.as_ptr(), options(nostack)) };
         Tiles
     }
@@ -200,7 +191,7 @@ unsafe fn block(
 /// (fused linear layers), the same f32 addition as a separate pass.
 ///
 /// # Safety
-/// As [`crate::bf16dot::matmul_bf16dot`]; [`amx_active`] must be true; m, n, k > 0;
+/// As [`crate::bf16dot::matmul_bf16dot`]; [`amx_available`] must be true; m, n, k > 0;
 /// `bias`, if any, holds n values.
 pub(crate) unsafe fn matmul(
     m: usize,

@@ -8,7 +8,8 @@
 //! but the same precision, so a fit does not change its meaning with the machine).
 //!
 //! The caller chooses the precision per product ([`crate::Precision`], an argument of
-//! [`crate::matmul`]); nothing here is global but the AMX switch for tests.
+//! [`crate::matmul`]), and so does whether the product takes the AMX tiles where they are
+//! available ([`crate::amx`]); nothing here is per thread or per process.
 //!
 //! The kernel computes a 12 x 32 tile of the output in 24 zmm accumulators over the whole inner
 //! dimension. The left operand is read as bf16 pairs (two consecutive k of one row, one u32),
@@ -33,27 +34,18 @@ pub fn bf16_dot_native() -> bool {
     }
 }
 
-/// Whether the bf16 products run on Intel's AMX tiles ([`crate::amx`]): the CPU has
-/// AMX-TILE and AMX-BF16, Linux granted the tile registers, and `CPU_KERNELS_AMX=0` is not set.
-pub fn bf16_amx_active() -> bool {
+/// Whether bf16 products asked to take Intel's AMX tiles ([`crate::Precision::Bf16`] with
+/// `amx`) run on them in this process: the CPU has AMX-TILE and AMX-BF16 and Linux granted the
+/// tile registers ([`crate::amx`]).
+pub fn bf16_amx_available() -> bool {
     #[cfg(all(target_arch = "x86_64", target_os = "linux"))]
     {
-        crate::amx::amx_active()
+        crate::amx::amx_available()
     }
     #[cfg(not(all(target_arch = "x86_64", target_os = "linux")))]
     {
         false
     }
-}
-
-/// Lets the bf16 products use AMX tiles where [`bf16_amx_active`] finds them (the default), or
-/// keeps them on the AVX-512 kernel, for the whole process: for tests and benchmarks that
-/// compare the two kernels on one machine.
-pub fn set_bf16_amx_enabled(enabled: bool) {
-    #[cfg(all(target_arch = "x86_64", target_os = "linux"))]
-    crate::amx::set_amx_enabled(enabled);
-    #[cfg(not(all(target_arch = "x86_64", target_os = "linux")))]
-    let _ = enabled;
 }
 
 /// f32 -> bf16 bits, round to nearest even; NaN stays a quiet NaN.
@@ -109,11 +101,13 @@ impl MatRef {
 /// out (m x n, row-major, contiguous) = lhs (m x k) * rhs (k x n) [+ bias] with bf16 operands.
 /// Every element of `out` is written (it may start uninitialised). The bias (n values, one per
 /// column, added in f32 after the sum) goes into the AMX kernel's store; the other kernels add
-/// it in one pass afterwards.
+/// it in one pass afterwards. `amx`: on AMX tiles where [`bf16_amx_available`] finds them,
+/// else (and everywhere without them) on the AVX512-BF16 kernel or emulated.
 ///
 /// # Safety
 /// `lhs` and `rhs` must address valid m x k and k x n matrices, `out` m * n writable floats;
 /// `bias`, if any, holds n values.
+#[allow(clippy::too_many_arguments)]
 pub unsafe fn matmul_bf16dot(
     m: usize,
     n: usize,
@@ -122,6 +116,7 @@ pub unsafe fn matmul_bf16dot(
     rhs: MatRef,
     out: *mut f32,
     bias: Option<&[f32]>,
+    amx: bool,
 ) {
     if m == 0 || n == 0 {
         return;
@@ -129,8 +124,10 @@ pub unsafe fn matmul_bf16dot(
     if k == 0 {
         unsafe { core::ptr::write_bytes(out, 0, m * n) };
     } else {
+        #[cfg(not(all(target_arch = "x86_64", target_os = "linux")))]
+        let _ = amx;
         #[cfg(all(target_arch = "x86_64", target_os = "linux"))]
-        if crate::amx::amx_active() {
+        if amx && crate::amx::amx_available() {
             unsafe { crate::amx::matmul(m, n, k, lhs, rhs, out, bias) };
             return;
         }

@@ -7,7 +7,7 @@
 //!
 //! | path | when | module |
 //! | --- | --- | --- |
-//! | bf16 operands, f32 sums (AMX tiles, else `vdpbf16ps`, else emulated) | [`Precision::Bf16`], n >= 16, k >= 8, m n k >= 2^18 | [`bf16dot`], [`amx`] |
+//! | bf16 operands, f32 sums (AMX tiles, else `vdpbf16ps`, else emulated) | [`Precision::Bf16`] (`amx`), n >= 16, k >= 8, m n k >= 2^18 | [`bf16dot`], [`amx`] |
 //! | f32, k summed in blocks in parallel | a long k (>= 8,192) into a small output (<= 256 x 256): weight gradients | [`split_k`] |
 //! | f32 gemm in blocks of rows on every thread, bias added while the block is in cache | a bias, or at least two blocks of rows (2,048 rows at 128 columns); n >= 16 | [`gemm_f32`] |
 //! | f32 gemm (the `gemm` crate, as burn-flex calls it) | everything else | [`gemm_f32`] |
@@ -17,9 +17,8 @@
 //! over k. A bias is added after the sum with one f32 addition per element, so `matmul` with a
 //! bias equals `matmul` without it followed by the broadcast add, to the bit.
 //!
-//! The precision is an argument of every call: nothing here is per thread or per process, but
-//! [`set_bf16_amx_enabled`], a switch for tests and benchmarks that compare the two bf16
-//! kernels on one machine (and `CPU_KERNELS_AMX=0`, which turns AMX off for a process).
+//! The precision is an argument of every call, and with it whether a bf16 product takes the
+//! AMX tiles where the machine has them: nothing here is per thread or per process.
 
 extern crate alloc;
 
@@ -30,10 +29,7 @@ pub mod elementwise;
 pub mod gemm_f32;
 pub mod split_k;
 
-pub use bf16dot::{
-    MatRef, bf16_amx_active, bf16_dot_native, emulated_row_major, round_to_bf16,
-    set_bf16_amx_enabled,
-};
+pub use bf16dot::{MatRef, bf16_amx_available, bf16_dot_native, emulated_row_major, round_to_bf16};
 
 /// The precision of an f32 matrix product.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -42,8 +38,13 @@ pub enum Precision {
     #[default]
     F32,
     /// Operands rounded to bf16 (round to nearest even), products summed in f32: PyTorch's
-    /// `torch.set_float32_matmul_precision("medium")` on the CPU.
-    Bf16,
+    /// `torch.set_float32_matmul_precision("medium")` on the CPU. `amx`: on Intel's AMX tiles
+    /// where the CPU and the OS allow them ([`bf16_amx_available`]), else on the AVX512-BF16
+    /// kernel; the two sum in different orders, so their values differ in the last bits.
+    Bf16 {
+        /// Take the AMX tiles where they are available.
+        amx: bool,
+    },
 }
 
 /// Whether an m x k by k x n product in [`Precision::Bf16`] takes the bf16 kernels: products
@@ -76,9 +77,11 @@ pub unsafe fn matmul(
     if let Some(b) = bias {
         assert_eq!(b.len(), n, "cpu_kernels::matmul: bias of {} values for {n} columns", b.len());
     }
-    if precision == Precision::Bf16 && takes_bf16(m, n, k) {
+    if let Precision::Bf16 { amx } = precision
+        && takes_bf16(m, n, k)
+    {
         // SAFETY: the caller's contract, which is the kernel's.
-        unsafe { bf16dot::matmul_bf16dot(m, n, k, lhs, rhs, out, bias) };
+        unsafe { bf16dot::matmul_bf16dot(m, n, k, lhs, rhs, out, bias, amx) };
         return;
     }
     let blocks = split_k::split_k_blocks(m, n, k);

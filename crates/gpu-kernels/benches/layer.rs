@@ -17,7 +17,7 @@ use cubecl::prelude::*;
 use gpu_kernels::checks;
 use gpu_kernels::gemm::Tiling;
 use gpu_kernels::linear::Precision::{self, F32};
-use gpu_kernels::linear::{self, Matrix};
+use gpu_kernels::linear::{self, Matrix, Tuning};
 use std::time::Instant;
 
 const WIDTH: u32 = 128;
@@ -34,13 +34,13 @@ fn wait(client: &Client) {
     cubecl::future::block_on(client.sync()).expect("the device is lost");
 }
 
-type Op = fn(&Client, &Matrix, &Matrix, &Matrix, &Handle, Precision) -> Matrix;
+type Op = fn(&Client, &Matrix, &Matrix, &Matrix, &Handle, (Precision, Tuning)) -> Matrix;
 type Handle = cubecl::server::Handle;
 
 const OPS: [(&str, Op); 3] = [
-    ("forward", |c, x, w, _, b, p| linear::forward(c, x, w, Some(b), true, p).unwrap()),
-    ("input gradient", |c, _, w, dy, _, p| linear::x_backward(c, w, dy, p).unwrap()),
-    ("weight gradient", |c, x, _, dy, _, p| linear::weight_backward(c, x, dy, p).unwrap()),
+    ("forward", |c, x, w, _, b, (p, t)| linear::forward(c, x, w, Some(b), true, p, t).unwrap()),
+    ("input gradient", |c, _, w, dy, _, (p, t)| linear::x_backward(c, w, dy, p, t).unwrap()),
+    ("weight gradient", |c, x, _, dy, _, (p, t)| linear::weight_backward(c, x, dy, p, t).unwrap()),
 ];
 
 /// The runtime: `GPU_KERNELS_RUNTIME=cuda` (with the `cuda` feature), else wgpu.
@@ -81,7 +81,7 @@ fn layer(c: &mut Criterion) {
         let mut default_seconds = None;
         for &(label, tiling, checked, precision) in &variants {
             checks::set_checked(checked);
-            linear::set_tiling(tiling);
+            let precision = (precision, Tuning { tiling, split_len: None });
             // Compiles the kernel outside the timing.
             op(&client, &x, &w, &dy, &b.handle, precision);
             wait(&client);
@@ -108,7 +108,6 @@ fn layer(c: &mut Criterion) {
         }
     }
     checks::set_checked(false);
-    linear::set_tiling(Tiling::T64);
     group.finish();
     for line in summary {
         eprintln!("{line}");

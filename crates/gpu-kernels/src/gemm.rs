@@ -27,9 +27,10 @@ use cubecl::prelude::*;
 pub const UNITS: u32 = 16;
 
 /// The tile of C one cube computes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Tiling {
-    /// 64 x 64, 4 x 4 sums a unit: many cubes for short or narrow products.
+    /// 64 x 64, 4 x 4 sums a unit: many cubes for short or narrow products (the default).
+    #[default]
     T64,
     /// 128 x 128, 8 x 8 sums a unit: twice the arithmetic per shared-memory read.
     T128,

@@ -12,9 +12,9 @@
 //! | [`linear`] | a layer's five operations on row-major [`linear::Matrix`]es, shapes checked |
 //! | [`checks`] | whether the kernels launch with CubeCL's index checks (off by default) |
 //!
-//! Every sum runs in an order fixed by the shapes (split counts depend on the shapes alone, and
-//! on two process-wide tuning settings, [`linear::set_split_len`] and [`linear::set_tiling`]),
-//! so a result is the same bits run to run. The tests (`--features wgpu`) compare each
+//! Every sum runs in an order fixed by the shapes and the call's arguments (split counts depend
+//! on the shapes and the [`linear::Tuning`] handed to each call, nothing per process), so a
+//! result is the same bits run to run. The tests (`--features wgpu`) compare each
 //! operation with an f64 reference on any Vulkan device, Mesa's lavapipe included.
 
 pub mod checks;

@@ -5,14 +5,15 @@
 //! buffers. Every sum runs in an order fixed by the shapes alone, so the results are the same
 //! bits on every run of one device. The three products take a [`Precision`]: f32 operands on
 //! the tiled kernels of [`crate::gemm`], or bf16 operands on tensor cores
-//! ([`crate::gemm_cmma`], where the device has them; sums in f32 either way).
+//! ([`crate::gemm_cmma`], where the device has them; sums in f32 either way), and a [`Tuning`]:
+//! the f32 tile and the weight gradient's split length. Both are arguments of every call,
+//! never a per-thread or per-process setting, so a product's arguments say everything that
+//! decides its value.
 
 use crate::gemm::Tiling;
 use crate::{elementwise, gemm, gemm_cmma, reduce};
 use cubecl::prelude::*;
 use cubecl::server::Handle;
-use std::cell::Cell;
-use std::sync::atomic::{AtomicU32, Ordering};
 
 /// A row-major `rows x cols` f32 matrix on the device.
 #[derive(Clone, Debug)]
@@ -73,7 +74,7 @@ pub enum Precision {
     /// Operands rounded to bf16 (8 bits of mantissa), multiplied on tensor cores
     /// ([`crate::gemm_cmma`]); only where [`bf16_supported`] (CUDA on Ampere or later), and
     /// only for products large enough to gain ([`takes_bf16`]; the others run in f32). The
-    /// tile is the kernel's own; [`set_tiling`] does not apply.
+    /// tile is the kernel's own; [`Tuning::tiling`] does not apply.
     Bf16,
 }
 
@@ -165,66 +166,31 @@ pub const BIAS_BLOCK_ROWS: u32 = 128;
 /// The most cubes along a grid axis the kernels launch (the limit of Vulkan and WebGPU).
 const MAX_CUBES: u32 = 65_535;
 
-/// 0: the default rule of [`splits`]; else a fixed split length ([`set_split_len`]).
-static SPLIT_LEN_NOW: AtomicU32 = AtomicU32::new(0);
-/// 0: [`Tiling::T64`], the default; 128: [`Tiling::T128`]; 65: [`Tiling::T64V`]; 129:
-/// [`Tiling::T128V`] ([`set_tiling`]).
-static TILING_NOW: AtomicU32 = AtomicU32::new(0);
-
-thread_local! {
-    static TILING_HERE: Cell<Option<Tiling>> = const { Cell::new(None) };
+/// How a layer's products are launched beyond their precision: the f32 tile, and the batch
+/// length of every split of a weight gradient.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Tuning {
+    /// The tile of the f32 products (default [`Tiling::T64`]).
+    pub tiling: Tiling,
+    /// A fixed batch length for every split of a weight gradient (`None`: the default rule of
+    /// [`splits`]); [`Tuning::with_split_len`] checks it.
+    pub split_len: Option<u32>,
 }
 
-/// Sets a fixed batch length for every split of a weight gradient in this process (a power of
-/// two from 64 to 65,536; anything else is refused and changes nothing), or `None` for the
-/// default rule of [`splits`]. A tuning knob for benchmarks: the number of splits, and so the
-/// order of every sum, stays a function of the shapes and this setting.
-pub fn set_split_len(len: Option<u32>) -> Result<(), ShapeError> {
-    if let Some(len) = len {
-        check(len.is_power_of_two() && (64..=65_536).contains(&len), || {
-            format!("split length {len}: expected a power of two from 64 to 65536")
-        })?;
-    }
-    SPLIT_LEN_NOW.store(len.unwrap_or(0), Ordering::Relaxed);
-    Ok(())
-}
-
-/// Sets the tile of every product in this process (a tuning knob for benchmarks; the default
-/// is [`Tiling::T64`]).
-pub fn set_tiling(tiling: Tiling) {
-    let code = match tiling {
-        Tiling::T64 => 0,
-        Tiling::T128 => 128,
-        Tiling::T64V => 65,
-        Tiling::T128V => 129,
-    };
-    TILING_NOW.store(code, Ordering::Relaxed);
-}
-
-/// The tile of this thread's products: a [`TilingScope`]'s, else the process's.
-pub fn tiling() -> Tiling {
-    TILING_HERE.with(Cell::get).unwrap_or(match TILING_NOW.load(Ordering::Relaxed) {
-        128 => Tiling::T128,
-        65 => Tiling::T64V,
-        129 => Tiling::T128V,
-        _ => Tiling::T64,
-    })
-}
-
-/// Sets this thread's tile until dropped (tests run both tiles side by side).
-#[must_use = "the tile applies only while the scope lives"]
-pub struct TilingScope(Option<Tiling>);
-
-impl TilingScope {
-    /// This thread's products use `tiling` while the scope lives.
-    pub fn new(tiling: Tiling) -> Self {
-        Self(TILING_HERE.with(|t| t.replace(Some(tiling))))
-    }
-}
-
-impl Drop for TilingScope {
-    fn drop(&mut self) {
-        TILING_HERE.with(|t| t.set(self.0));
+impl Tuning {
+    /// This tuning with every split of a weight gradient summing `len` batch rows (a power of
+    /// two from 64 to 65,536), or `None` for the default rule of [`splits`]. The number of
+    /// splits, and so the order of every sum, stays a function of the shapes and this value.
+    ///
+    /// # Errors
+    /// A length outside that range.
+    pub fn with_split_len(self, len: Option<u32>) -> Result<Tuning, ShapeError> {
+        if let Some(len) = len {
+            check(len.is_power_of_two() && (64..=65_536).contains(&len), || {
+                format!("split length {len}: expected a power of two from 64 to 65536")
+            })?;
+        }
+        Ok(Tuning { split_len: len, ..self })
     }
 }
 
@@ -237,7 +203,8 @@ fn check_grid(op: &str, cubes: u32) -> Result<(), ShapeError> {
 }
 
 /// `x W (+ bias) (ReLU)` for x `[rows, d_in]`, W `[d_in, d_out]`, bias `[d_out]`, the product
-/// in `precision`.
+/// in `precision` on `tuning`'s tile.
+#[allow(clippy::too_many_arguments)]
 pub fn forward(
     client: &Client,
     x: &Matrix,
@@ -245,13 +212,14 @@ pub fn forward(
     bias: Option<&Handle>,
     relu: bool,
     precision: Precision,
+    tuning: Tuning,
 ) -> Result<Matrix, ShapeError> {
     check(x.cols == w.rows, || {
         format!("linear forward: x is {} x {} but W is {} x {}", x.rows, x.cols, w.rows, w.cols)
     })?;
     check_precision(client, "linear forward", precision)?;
     let precision = effective(precision, x.rows, w.cols, x.cols);
-    let tiling = tiling();
+    let tiling = tuning.tiling;
     check_grid("linear forward", x.rows.div_ceil(tile_of(precision, tiling)))?;
     let y = Matrix::empty(client, x.rows, w.cols);
     let epilogue = match (bias.is_some(), relu) {
@@ -288,19 +256,20 @@ pub fn forward(
 }
 
 /// The input gradient `dY Wᵀ` `[rows, d_in]` for W `[d_in, d_out]` and dY `[rows, d_out]`, in
-/// `precision`.
+/// `precision` on `tuning`'s tile.
 pub fn x_backward(
     client: &Client,
     w: &Matrix,
     dy: &Matrix,
     precision: Precision,
+    tuning: Tuning,
 ) -> Result<Matrix, ShapeError> {
     check(dy.cols == w.cols, || {
         format!("input gradient: dY is {} x {} but W is {} x {}", dy.rows, dy.cols, w.rows, w.cols)
     })?;
     check_precision(client, "input gradient", precision)?;
     let precision = effective(precision, dy.rows, w.rows, w.cols);
-    let tiling = tiling();
+    let tiling = tuning.tiling;
     check_grid("input gradient", dy.rows.div_ceil(tile_of(precision, tiling)))?;
     let dx = Matrix::empty(client, dy.rows, w.rows);
     let shape = gemm::GemmShape {
@@ -329,15 +298,15 @@ pub fn x_backward(
 
 /// The number of splits of a weight gradient's sum over `rows` whose `[d_in, d_out]` output
 /// takes `tiles` tiles: enough for [`TARGET_CUBES`] cubes in all, each split summing at least
-/// [`MIN_SPLIT_ROWS`] rows, at most [`MAX_SPLITS`] (or `rows / len` for a length set with
-/// [`set_split_len`]). A function of the shapes (and that setting) alone.
-pub fn splits(rows: u32, tiles: u32) -> u32 {
-    match SPLIT_LEN_NOW.load(Ordering::Relaxed) {
-        0 => {
+/// [`MIN_SPLIT_ROWS`] rows, at most [`MAX_SPLITS`] (or `rows / len` for a fixed `split_len`,
+/// [`Tuning::split_len`]). A function of the shapes (and that length) alone.
+pub fn splits(rows: u32, tiles: u32, split_len: Option<u32>) -> u32 {
+    match split_len {
+        None | Some(0) => {
             let wanted = TARGET_CUBES.div_ceil(tiles.max(1));
             wanted.min(rows / MIN_SPLIT_ROWS).clamp(1, MAX_SPLITS)
         }
-        len => rows.div_ceil(len).clamp(1, MAX_SPLITS),
+        Some(len) => rows.div_ceil(len).clamp(1, MAX_SPLITS),
     }
 }
 
@@ -349,21 +318,23 @@ pub fn bias_blocks(rows: u32) -> u32 {
 }
 
 /// The weight gradient `Xᵀ dY` `[d_in, d_out]` for x `[rows, d_in]` and dY `[rows, d_out]`:
-/// [`splits`] partial sums over blocks of rows (products in `precision`), added in order (f32).
+/// [`splits`] partial sums over blocks of rows (products in `precision` on `tuning`'s tile and
+/// split length), added in order (f32).
 pub fn weight_backward(
     client: &Client,
     x: &Matrix,
     dy: &Matrix,
     precision: Precision,
+    tuning: Tuning,
 ) -> Result<Matrix, ShapeError> {
     check(x.rows == dy.rows, || {
         format!("weight gradient: x is {} x {} but dY is {} x {}", x.rows, x.cols, dy.rows, dy.cols)
     })?;
     check_precision(client, "weight gradient", precision)?;
     let precision = effective(precision, x.cols, dy.cols, x.rows);
-    let tiling = tiling();
+    let tiling = tuning.tiling;
     let tile = tile_of(precision, tiling);
-    let s = splits(x.rows, x.cols.div_ceil(tile) * dy.cols.div_ceil(tile));
+    let s = splits(x.rows, x.cols.div_ceil(tile) * dy.cols.div_ceil(tile), tuning.split_len);
     let shape = gemm::GemmShape {
         m: x.cols,
         n: dy.cols,
@@ -452,39 +423,26 @@ pub fn relu_backward(client: &Client, x: &Matrix, grad: &Matrix) -> Result<Matri
 mod tests {
     use super::*;
 
-    /// The default rule fills the GPU; a set length is taken only when valid; a refused one
-    /// changes nothing. One test, because the settings are the process's.
+    /// The default rule fills the GPU; a fixed length is taken only when valid.
     #[test]
-    fn split_counts_follow_the_rule_and_the_setting() {
+    fn split_counts_follow_the_rule_and_the_length() {
         // A 128 x 128 gradient on 64-wide tiles (4 tiles) at 2^15: 64 splits of 512 rows.
-        assert_eq!(splits(32_768, 4), 64);
-        assert_eq!(splits(32_768, 1), 256);
-        assert_eq!(splits(8_192, 4), 64);
-        assert_eq!(splits(1_000, 4), 7);
-        assert_eq!(splits(1, 4), 1);
-        assert_eq!(splits(100_000, 1_000), 1);
+        assert_eq!(splits(32_768, 4, None), 64);
+        assert_eq!(splits(32_768, 1, None), 256);
+        assert_eq!(splits(8_192, 4, None), 64);
+        assert_eq!(splits(1_000, 4, None), 7);
+        assert_eq!(splits(1, 4, None), 1);
+        assert_eq!(splits(100_000, 1_000, None), 1);
         assert_eq!(bias_blocks(32_768), 256);
         assert_eq!(bias_blocks(1), 1);
         for bad in [0, 1, 32, 100, 3000, 131_072] {
-            let e = set_split_len(Some(bad)).unwrap_err().to_string();
+            let e = Tuning::default().with_split_len(Some(bad)).unwrap_err().to_string();
             assert!(e.contains(&bad.to_string()) && e.contains("power of two"), "{e}");
         }
-        assert_eq!(splits(32_768, 4), 64);
-        set_split_len(Some(2048)).unwrap();
-        assert_eq!(splits(32_768, 4), 16);
-        assert_eq!(splits(1, 4), 1);
-        set_split_len(None).unwrap();
-        assert_eq!(splits(32_768, 4), 64);
-    }
-
-    #[test]
-    fn a_tiling_scope_sets_this_thread_only_and_restores() {
-        assert_eq!(tiling(), Tiling::T64);
-        {
-            let _scope = TilingScope::new(Tiling::T128);
-            assert_eq!(tiling(), Tiling::T128);
-            std::thread::spawn(|| assert_eq!(tiling(), Tiling::T64)).join().unwrap();
-        }
-        assert_eq!(tiling(), Tiling::T64);
+        let t = Tuning::default().with_split_len(Some(2048)).unwrap();
+        assert_eq!(splits(32_768, 4, t.split_len), 16);
+        assert_eq!(splits(1, 4, t.split_len), 1);
+        assert_eq!(t.with_split_len(None).unwrap(), Tuning::default());
+        assert_eq!(Tuning::default().tiling, Tiling::T64);
     }
 }

@@ -14,7 +14,7 @@ use cubecl::prelude::*;
 use gpu_kernels::checks;
 use gpu_kernels::gemm::Tiling;
 use gpu_kernels::linear::Precision::{Bf16, F32};
-use gpu_kernels::linear::{self, Matrix, TilingScope};
+use gpu_kernels::linear::{self, Matrix, Tuning};
 use test_support::assert_close;
 
 /// The runtime under test: `GPU_KERNELS_RUNTIME=cuda` (with the `cuda` feature), else wgpu.
@@ -84,13 +84,13 @@ const SHAPES: [(u32, u32, u32); 5] =
 #[test]
 fn forward_matches_the_reference_with_and_without_bias_and_relu() {
     for tiling in Tiling::ALL {
-        let _scope = TilingScope::new(tiling);
         forward_matches_on(tiling);
     }
 }
 
 fn forward_matches_on(tiling: Tiling) {
     let client = client();
+    let tu = Tuning { tiling, split_len: None };
     for (t, &(rows, d_in, d_out)) in SHAPES.iter().enumerate() {
         let (m, k, n) = (rows as usize, d_in as usize, d_out as usize);
         let xv = values(m * k, 1 + t as u64);
@@ -104,16 +104,16 @@ fn forward_matches_on(tiling: Tiling) {
             plain.iter().enumerate().map(|(e, v)| v + bv[e % n] as f64).collect();
         let relu: Vec<f64> = with_bias.iter().map(|v| v.max(0.0)).collect();
         let tol = 4e-7 * k as f64;
-        let got = linear::forward(&client, &x, &w, None, false, F32).unwrap().read(&client);
+        let got = linear::forward(&client, &x, &w, None, false, F32, tu).unwrap().read(&client);
         assert_close(&format!("x W {rows}x{d_in}x{d_out} {tiling:?}"), &got, &plain, tol);
-        let got = linear::forward(&client, &x, &w, Some(&b.handle), false, F32).unwrap();
+        let got = linear::forward(&client, &x, &w, Some(&b.handle), false, F32, tu).unwrap();
         assert_close(
             &format!("x W + b {rows}x{d_in}x{d_out} {tiling:?}"),
             &got.read(&client),
             &with_bias,
             tol,
         );
-        let got = linear::forward(&client, &x, &w, Some(&b.handle), true, F32).unwrap();
+        let got = linear::forward(&client, &x, &w, Some(&b.handle), true, F32, tu).unwrap();
         let label = format!("relu {rows}x{d_in}x{d_out} {tiling:?}");
         assert_close(&label, &got.read(&client), &relu, tol);
     }
@@ -122,13 +122,13 @@ fn forward_matches_on(tiling: Tiling) {
 #[test]
 fn gradients_match_the_reference() {
     for tiling in Tiling::ALL {
-        let _scope = TilingScope::new(tiling);
         gradients_match_on(tiling);
     }
 }
 
 fn gradients_match_on(tiling: Tiling) {
     let client = client();
+    let tu = Tuning { tiling, split_len: None };
     for (t, &(rows, d_in, d_out)) in SHAPES.iter().enumerate() {
         let (m, k, n) = (rows as usize, d_in as usize, d_out as usize);
         let xv = values(m * k, 300 + t as u64);
@@ -139,11 +139,11 @@ fn gradients_match_on(tiling: Tiling) {
         let dy = Matrix::upload(&client, &dyv, rows, d_out).unwrap();
         let label = format!("{rows}x{d_in}x{d_out} {tiling:?}");
 
-        let dx = linear::x_backward(&client, &w, &dy, F32).unwrap().read(&client);
+        let dx = linear::x_backward(&client, &w, &dy, F32, tu).unwrap().read(&client);
         let want = product(&dyv, &transpose(&wv, k, n), m, n, k);
         assert_close(&format!("dY Wᵀ {label}"), &dx, &want, 4e-7 * n as f64);
 
-        let dw = linear::weight_backward(&client, &x, &dy, F32).unwrap();
+        let dw = linear::weight_backward(&client, &x, &dy, F32, tu).unwrap();
         let want = product(&transpose(&xv, m, k), &dyv, k, m, n);
         assert_close(&format!("Xᵀ dY {label}"), &dw.read(&client), &want, 4e-7 * m as f64);
 
@@ -161,10 +161,11 @@ fn results_are_the_same_bits_on_a_second_run() {
     let dyv = values((rows * d_out) as usize, 8);
     let x = Matrix::upload(&client, &xv, rows, d_in).unwrap();
     let dy = Matrix::upload(&client, &dyv, rows, d_out).unwrap();
-    assert_eq!(linear::splits(rows, 4), 64);
+    assert_eq!(linear::splits(rows, 4, None), 64);
+    let tu = Tuning::default();
     assert_eq!(linear::bias_blocks(rows), 157);
-    let first = linear::weight_backward(&client, &x, &dy, F32).unwrap().read(&client);
-    let second = linear::weight_backward(&client, &x, &dy, F32).unwrap().read(&client);
+    let first = linear::weight_backward(&client, &x, &dy, F32, tu).unwrap().read(&client);
+    let second = linear::weight_backward(&client, &x, &dy, F32, tu).unwrap().read(&client);
     assert!(first.iter().zip(&second).all(|(a, b)| a.to_bits() == b.to_bits()));
     let first = linear::bias_backward(&client, &dy).unwrap().read(&client);
     let second = linear::bias_backward(&client, &dy).unwrap().read(&client);
@@ -173,17 +174,17 @@ fn results_are_the_same_bits_on_a_second_run() {
 
 /// Every operation's outputs, on shapes that fill no tile, with one tile.
 fn all_outputs(client: &Client, tiling: Tiling) -> Vec<Vec<f32>> {
-    let _scope = TilingScope::new(tiling);
+    let tu = Tuning { tiling, split_len: None };
     let (rows, d_in, d_out) = (1_000u32, 70u32, 50u32);
     let x = Matrix::upload(client, &values((rows * d_in) as usize, 11), rows, d_in).unwrap();
     let w = Matrix::upload(client, &values((d_in * d_out) as usize, 12), d_in, d_out).unwrap();
     let b = Matrix::upload(client, &values(d_out as usize, 13), 1, d_out).unwrap();
     let dy = Matrix::upload(client, &values((rows * d_out) as usize, 14), rows, d_out).unwrap();
-    let y = linear::forward(client, &x, &w, Some(&b.handle), true, F32).unwrap();
+    let y = linear::forward(client, &x, &w, Some(&b.handle), true, F32, tu).unwrap();
     vec![
         y.read(client),
-        linear::x_backward(client, &w, &dy, F32).unwrap().read(client),
-        linear::weight_backward(client, &x, &dy, F32).unwrap().read(client),
+        linear::x_backward(client, &w, &dy, F32, tu).unwrap().read(client),
+        linear::weight_backward(client, &x, &dy, F32, tu).unwrap().read(client),
         linear::bias_backward(client, &dy).unwrap().read(client),
         linear::relu_backward(client, &y, &dy).unwrap().read(client),
     ]
@@ -214,6 +215,7 @@ fn checked_launches_give_the_same_bits_as_unchecked_ones() {
 #[test]
 fn relu_keeps_nan_and_its_backward_masks_the_gradient() {
     let client = client();
+    let tu = Tuning::default();
     // One row: x W + b with W = identity, so the ReLU sees the inputs themselves.
     let xv = [-2.0, -0.0, 0.0, 3.0, f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 1e-30];
     let n = xv.len() as u32;
@@ -227,7 +229,7 @@ fn relu_keeps_nan_and_its_backward_masks_the_gradient() {
     let x = Matrix::upload(&client, &finite, 1, n).unwrap();
     let w = Matrix::upload(&client, &id, n, n).unwrap();
     let b = Matrix::upload(&client, &vec![0.0; n as usize], 1, n).unwrap();
-    let y = linear::forward(&client, &x, &w, Some(&b.handle), true, F32).unwrap().read(&client);
+    let y = linear::forward(&client, &x, &w, Some(&b.handle), true, F32, tu).unwrap().read(&client);
     let want: Vec<f64> = finite.iter().map(|v| (*v as f64).max(0.0)).collect();
     assert_close("fused ReLU", &y, &want, 0.0);
 
@@ -240,13 +242,14 @@ fn relu_keeps_nan_and_its_backward_masks_the_gradient() {
 #[test]
 fn mismatched_shapes_are_errors_that_name_the_operation() {
     let client = client();
+    let tu = Tuning::default();
     let x = Matrix::upload(&client, &values(6, 1), 2, 3).unwrap();
     let w = Matrix::upload(&client, &values(8, 2), 4, 2).unwrap();
-    let e = linear::forward(&client, &x, &w, None, false, F32).unwrap_err().to_string();
+    let e = linear::forward(&client, &x, &w, None, false, F32, tu).unwrap_err().to_string();
     assert!(e.contains("linear forward") && e.contains("2 x 3") && e.contains("4 x 2"), "{e}");
-    let e = linear::weight_backward(&client, &x, &w, F32).unwrap_err().to_string();
+    let e = linear::weight_backward(&client, &x, &w, F32, tu).unwrap_err().to_string();
     assert!(e.contains("weight gradient"), "{e}");
-    let e = linear::x_backward(&client, &w, &x, F32).unwrap_err().to_string();
+    let e = linear::x_backward(&client, &w, &x, F32, tu).unwrap_err().to_string();
     assert!(e.contains("input gradient"), "{e}");
     let e = Matrix::upload(&client, &values(5, 1), 2, 3).unwrap_err().to_string();
     assert!(e.contains("5 values for a 2 x 3"), "{e}");
@@ -258,12 +261,16 @@ fn mismatched_shapes_are_errors_that_name_the_operation() {
 #[test]
 fn bf16_products_match_the_rounded_reference_or_are_refused() {
     let client = client();
+    let tu = Tuning::default();
     if !linear::bf16_supported(&client) {
         let x = Matrix::upload(&client, &values(4, 1), 2, 2).unwrap();
         let refusals = [
-            ("linear forward", linear::forward(&client, &x, &x, None, false, Bf16)),
-            ("input gradient", linear::x_backward(&client, &x, &x, Bf16)),
-            ("weight gradient", linear::weight_backward(&client, &x, &x, Bf16)),
+            (
+                "linear forward",
+                linear::forward(&client, &x, &x, None, false, Bf16, Tuning::default()),
+            ),
+            ("input gradient", linear::x_backward(&client, &x, &x, Bf16, Tuning::default())),
+            ("weight gradient", linear::weight_backward(&client, &x, &x, Bf16, Tuning::default())),
         ];
         for (op, result) in refusals {
             let e = result.unwrap_err().to_string();
@@ -289,7 +296,8 @@ fn bf16_products_match_the_rounded_reference_or_are_refused() {
         };
 
         let fwd = (rows, d_out, d_in);
-        let y = linear::forward(&client, &x, &w, Some(&b.handle), true, Bf16).unwrap();
+        let y = linear::forward(&client, &x, &w, Some(&b.handle), true, Bf16, Tuning::default())
+            .unwrap();
         let want: Vec<f64> = product(&seen(&xv, fwd), &seen(&wv, fwd), m, k, n)
             .iter()
             .enumerate()
@@ -298,18 +306,21 @@ fn bf16_products_match_the_rounded_reference_or_are_refused() {
         assert_close(&format!("relu(x W + b) {label}"), &y.read(&client), &want, 4e-7 * k as f64);
 
         let xb = (rows, d_in, d_out);
-        let dx = linear::x_backward(&client, &w, &dy, Bf16).unwrap().read(&client);
+        let dx =
+            linear::x_backward(&client, &w, &dy, Bf16, Tuning::default()).unwrap().read(&client);
         let want = product(&seen(&dyv, xb), &transpose(&seen(&wv, xb), k, n), m, n, k);
         assert_close(&format!("dY Wᵀ {label}"), &dx, &want, 4e-7 * n as f64);
 
         let wb = (d_in, d_out, rows);
-        let dw = linear::weight_backward(&client, &x, &dy, Bf16).unwrap().read(&client);
+        let dw = linear::weight_backward(&client, &x, &dy, Bf16, Tuning::default())
+            .unwrap()
+            .read(&client);
         let want = product(&transpose(&seen(&xv, wb), m, k), &seen(&dyv, wb), k, m, n);
         assert_close(&format!("Xᵀ dY {label}"), &dw, &want, 4e-7 * m as f64);
 
         // Rounding is what changed where the tensor cores ran.
         if linear::takes_bf16(rows, d_out, d_in) {
-            let f32_y = linear::forward(&client, &x, &w, Some(&b.handle), true, F32).unwrap();
+            let f32_y = linear::forward(&client, &x, &w, Some(&b.handle), true, F32, tu).unwrap();
             assert_ne!(f32_y.read(&client), y.read(&client), "{label}: bf16 gave the f32 result");
         }
     }

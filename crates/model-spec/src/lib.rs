@@ -3,7 +3,8 @@
 //! configured ([`ModelConfig`], serde, TOML), the direction features of the purely neural
 //! models ([`features`]: angle parametrizations, reciprocity options, positional encoding,
 //! computed on the CPU), the layer tables every model is built from ([`MlpConfig`], one
-//! [`layers`]), and the names of the backends and product precisions ([`backend`]). brdf-neural builds and trains the models on burn from these
+//! [`layers`]), the names of the backends and product precisions ([`backend`]), and how the linear layers
+//! run on a GPU ([`gpu_tuning`]). brdf-neural builds and trains the models on burn from these
 //! tables and re-exports every item under its old path; crates that only name models (the
 //! report's tables) depend on this crate and compile no tensor library.
 //!
@@ -46,6 +47,7 @@ pub mod backend;
 pub mod config;
 mod error;
 pub mod features;
+pub mod gpu_tuning;
 pub mod kind;
 pub mod layers;
 pub mod mlp;
@@ -54,6 +56,7 @@ pub use backend::{Backend, MatmulPrecision};
 pub use config::ModelConfig;
 pub use error::{Error, Result};
 pub use features::{AngleConfig, AngleParametrization, Reciprocity};
+pub use gpu_tuning::{GpuLinear, GpuTile, GpuTuning};
 pub use kind::Analytic;
 pub use kind::ModelKind;
 pub use mlp::MlpConfig;

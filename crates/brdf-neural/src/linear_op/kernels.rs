@@ -3,7 +3,9 @@
 //! `crate::cube_linear`, which burn's fusion runs as one custom operation each) and its
 //! autodiff implementation (one graph node per layer).
 
+#[cfg(feature = "flex")]
 use crate::precision::MatmulPrecision;
+use crate::products::Products;
 #[cfg(feature = "flex")]
 use burn::backend::Flex;
 use burn::backend::autodiff::NodeId;
@@ -18,12 +20,13 @@ use burn::backend::{Autodiff, Backend, Dispatch, backend_extension};
 use burn::tensor::Shape;
 use burn::tensor::Tensor;
 
-/// The kernels' spelling of a precision.
+/// The CPU kernels' spelling of a batch's products: the precision, and for bf16 whether AMX
+/// tiles are taken where available.
 #[cfg(feature = "flex")]
-fn kernel_precision(p: MatmulPrecision) -> cpu_kernels::Precision {
-    match p {
+fn kernel_precision(p: Products) -> cpu_kernels::Precision {
+    match p.precision {
         MatmulPrecision::F32 => cpu_kernels::Precision::F32,
-        MatmulPrecision::Bf16 => cpu_kernels::Precision::Bf16,
+        MatmulPrecision::Bf16 => cpu_kernels::Precision::Bf16 { amx: p.bf16_amx },
     }
 }
 
@@ -68,7 +71,7 @@ pub trait LinearKernels: Backend {
         x: FloatTensor<Self>,
         weight: FloatTensor<Self>,
         bias: FloatTensor<Self>,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> FloatTensor<Self>;
 
     /// `x W`, a layer without bias.
@@ -76,7 +79,7 @@ pub trait LinearKernels: Backend {
     fn kernel_linear_no_bias(
         x: FloatTensor<Self>,
         weight: FloatTensor<Self>,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> FloatTensor<Self>;
 
     /// The input gradient `dY Wᵀ`.
@@ -84,7 +87,7 @@ pub trait LinearKernels: Backend {
     fn kernel_linear_x_backward(
         weight: FloatTensor<Self>,
         output_grad: FloatTensor<Self>,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> FloatTensor<Self>;
 
     /// The weight gradient `Xᵀ dY`.
@@ -92,7 +95,7 @@ pub trait LinearKernels: Backend {
     fn kernel_linear_weight_backward(
         x: FloatTensor<Self>,
         output_grad: FloatTensor<Self>,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> FloatTensor<Self>;
 
     /// The bias gradient: `dY` `[rows, d_out]` summed over the rows.
@@ -115,33 +118,33 @@ impl LinearKernels for Flex {
         x: FloatTensor<Self>,
         weight: FloatTensor<Self>,
         bias: FloatTensor<Self>,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> FloatTensor<Self> {
-        crate::flex_linear::linear(x, weight, Some(bias), kernel_precision(precision))
+        crate::flex_linear::linear(x, weight, Some(bias), kernel_precision(products))
     }
 
     fn kernel_linear_no_bias(
         x: FloatTensor<Self>,
         weight: FloatTensor<Self>,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> FloatTensor<Self> {
-        crate::flex_linear::linear(x, weight, None, kernel_precision(precision))
+        crate::flex_linear::linear(x, weight, None, kernel_precision(products))
     }
 
     fn kernel_linear_x_backward(
         weight: FloatTensor<Self>,
         output_grad: FloatTensor<Self>,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> FloatTensor<Self> {
-        crate::flex_linear::linear_x_backward(weight, output_grad, kernel_precision(precision))
+        crate::flex_linear::linear_x_backward(weight, output_grad, kernel_precision(products))
     }
 
     fn kernel_linear_weight_backward(
         x: FloatTensor<Self>,
         output_grad: FloatTensor<Self>,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> FloatTensor<Self> {
-        crate::flex_linear::linear_weight_backward(x, output_grad, kernel_precision(precision))
+        crate::flex_linear::linear_weight_backward(x, output_grad, kernel_precision(products))
     }
 
     fn kernel_linear_bias_backward(output_grad: FloatTensor<Self>) -> FloatTensor<Self> {
@@ -166,13 +169,13 @@ struct LinearBackward;
 #[derive(Debug)]
 struct LinearNoBiasBackward;
 
-/// The checkpointed x and W of a layer, and the precision of its products.
-type LinearState = (Option<NodeId>, Option<NodeId>, MatmulPrecision);
+/// The checkpointed x and W of a layer, and how its products are computed.
+type LinearState = (Option<NodeId>, Option<NodeId>, Products);
 
 /// Registers the gradients of x and W (where their nodes are tracked) for `grad`.
 fn register_x_and_weight<B: LinearKernels>(
     [node_x, node_weight]: [Option<NodeId>; 2],
-    (x_state, weight_state, precision): LinearState,
+    (x_state, weight_state, products): LinearState,
     grad: &B::FloatTensorPrimitive,
     grads: &mut Gradients,
     checkpointer: &mut Checkpointer,
@@ -181,10 +184,10 @@ fn register_x_and_weight<B: LinearKernels>(
     let weight =
         weight_state.map(|id| checkpointer.retrieve_node_output::<B::FloatTensorPrimitive>(id));
     if let (Some(id), Some(weight)) = (node_x, weight) {
-        grads.register::<B>(id, B::kernel_linear_x_backward(weight, grad.clone(), precision));
+        grads.register::<B>(id, B::kernel_linear_x_backward(weight, grad.clone(), products));
     }
     if let (Some(id), Some(x)) = (node_weight, x) {
-        grads.register::<B>(id, B::kernel_linear_weight_backward(x, grad.clone(), precision));
+        grads.register::<B>(id, B::kernel_linear_weight_backward(x, grad.clone(), products));
     }
 }
 
@@ -250,7 +253,7 @@ impl<B: LinearKernels, C: CheckpointStrategy> LinearKernels for Autodiff<B, C> {
         x: FloatTensor<Self>,
         weight: FloatTensor<Self>,
         bias: FloatTensor<Self>,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> FloatTensor<Self> {
         let (x_tracked, weight_tracked) = (x.is_tracked(), weight.is_tracked());
         match LinearBackward
@@ -264,15 +267,12 @@ impl<B: LinearKernels, C: CheckpointStrategy> LinearKernels for Autodiff<B, C> {
                 let weight_state = x_tracked.then(|| prep.checkpoint(&weight));
                 let (x, w, b) =
                     (x.into_primitive(), weight.into_primitive(), bias.into_primitive());
-                prep.finish(
-                    (x_state, weight_state, precision),
-                    B::kernel_linear(x, w, b, precision),
-                )
+                prep.finish((x_state, weight_state, products), B::kernel_linear(x, w, b, products))
             }
             OpsKind::UnTracked(prep) => {
                 let (x, w, b) =
                     (x.into_primitive(), weight.into_primitive(), bias.into_primitive());
-                prep.finish(B::kernel_linear(x, w, b, precision))
+                prep.finish(B::kernel_linear(x, w, b, products))
             }
         }
     }
@@ -280,7 +280,7 @@ impl<B: LinearKernels, C: CheckpointStrategy> LinearKernels for Autodiff<B, C> {
     fn kernel_linear_no_bias(
         x: FloatTensor<Self>,
         weight: FloatTensor<Self>,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> FloatTensor<Self> {
         let (x_tracked, weight_tracked) = (x.is_tracked(), weight.is_tracked());
         match LinearNoBiasBackward
@@ -292,12 +292,12 @@ impl<B: LinearKernels, C: CheckpointStrategy> LinearKernels for Autodiff<B, C> {
                 let x_state = weight_tracked.then(|| prep.checkpoint(&x));
                 let weight_state = x_tracked.then(|| prep.checkpoint(&weight));
                 let (x, w) = (x.into_primitive(), weight.into_primitive());
-                let y = B::kernel_linear_no_bias(x, w, precision);
-                prep.finish((x_state, weight_state, precision), y)
+                let y = B::kernel_linear_no_bias(x, w, products);
+                prep.finish((x_state, weight_state, products), y)
             }
             OpsKind::UnTracked(prep) => {
                 let (x, w) = (x.into_primitive(), weight.into_primitive());
-                prep.finish(B::kernel_linear_no_bias(x, w, precision))
+                prep.finish(B::kernel_linear_no_bias(x, w, products))
             }
         }
     }
@@ -324,7 +324,7 @@ impl<B: LinearKernels, C: CheckpointStrategy> LinearKernels for Autodiff<B, C> {
     fn kernel_linear_x_backward(
         _weight: FloatTensor<Self>,
         _output_grad: FloatTensor<Self>,
-        _precision: MatmulPrecision,
+        _products: Products,
     ) -> FloatTensor<Self> {
         unreachable!("the input gradient is computed on the inner backend")
     }
@@ -332,7 +332,7 @@ impl<B: LinearKernels, C: CheckpointStrategy> LinearKernels for Autodiff<B, C> {
     fn kernel_linear_weight_backward(
         _x: FloatTensor<Self>,
         _output_grad: FloatTensor<Self>,
-        _precision: MatmulPrecision,
+        _products: Products,
     ) -> FloatTensor<Self> {
         unreachable!("the weight gradient is computed on the inner backend")
     }
@@ -350,13 +350,13 @@ pub(super) fn linear(
     x: Tensor<2>,
     weight: Tensor<2>,
     bias: Option<Tensor<1>>,
-    precision: MatmulPrecision,
+    products: Products,
 ) -> Tensor<2> {
     let (x, weight) = (x.into_dispatch(), weight.into_dispatch());
     Tensor::from_dispatch(match bias {
         Some(b) => {
-            <Dispatch as LinearKernels>::kernel_linear(x, weight, b.into_dispatch(), precision)
+            <Dispatch as LinearKernels>::kernel_linear(x, weight, b.into_dispatch(), products)
         }
-        None => <Dispatch as LinearKernels>::kernel_linear_no_bias(x, weight, precision),
+        None => <Dispatch as LinearKernels>::kernel_linear_no_bias(x, weight, products),
     })
 }

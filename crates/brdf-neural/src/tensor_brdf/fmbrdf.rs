@@ -8,7 +8,7 @@
 
 use super::geometry::DEN_EPS;
 use super::{FmbrdfNets, Geometry};
-use crate::precision::MatmulPrecision;
+use crate::products::Products;
 use brdf_analytic::quadrature::gauss_legendre;
 use burn::tensor::{Device, Tensor, TensorData};
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -79,14 +79,14 @@ pub fn fmbrdf(
     p: &FmbrdfTensorParams,
     nets: &FmbrdfNets,
     g: &Geometry,
-    precision: MatmulPrecision,
+    products: Products,
 ) -> Tensor<2> {
     let fm = g.fmbrdf.as_ref().expect("geometry built without FMBRDF terms");
     let n = g.len();
     let device = g.mask.device();
     let c = fmbrdf_normalization(p.alpha.clone(), p.beta.clone(), &device);
     let lambda = nets
-        .lambda(fm.tan_lv.clone(), &fm.tan_lv_host, p.alpha.clone(), p.beta.clone(), precision)
+        .lambda(fm.tan_lv.clone(), &fm.tan_lv_host, p.alpha.clone(), p.beta.clone(), products)
         .add_scalar(1.0);
     let g_smith = (lambda.clone().narrow(0, 0, n) * lambda.narrow(0, n, n)).recip();
     let dist = (fm.theta_h.clone() / p.alpha.clone()).powf(p.beta.clone()).neg().exp()
@@ -104,7 +104,7 @@ pub fn fmbrdf(
         ],
         1,
     );
-    let i_b = nets.body(fm.body.clone(), body_params, precision);
+    let i_b = nets.body(fm.body.clone(), body_params, products);
     let scale = g_smith / fm.nl.clone().add_scalar(DEN_EPS);
     (i_s + p.rho.clone() * i_b) * scale * g.mask.clone()
 }

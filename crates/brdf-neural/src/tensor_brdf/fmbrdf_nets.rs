@@ -6,7 +6,7 @@
 //! through them to their inputs (alpha, beta, eta, kappa).
 
 use super::lambda_segments::Segments;
-use crate::precision::MatmulPrecision;
+use crate::products::Products;
 use burn::module::Module;
 use burn::tensor::activation::{relu, softplus};
 use burn::tensor::{Device, Int, Tensor, TensorData};
@@ -21,10 +21,10 @@ pub struct FixedLinear {
 }
 
 impl FixedLinear {
-    fn forward(&self, x: Tensor<2>, precision: MatmulPrecision) -> Tensor<2> {
+    fn forward(&self, x: Tensor<2>, products: Products) -> Tensor<2> {
         let [_, n] = self.bias.dims();
         let bias = self.bias.clone().reshape([n]);
-        crate::linear_op::linear(x, self.weight.clone(), Some(bias), precision)
+        crate::linear_op::linear(x, self.weight.clone(), Some(bias), products)
     }
 }
 
@@ -108,7 +108,7 @@ impl FmbrdfNets {
         tan_host: &[f32],
         alpha: Tensor<2>,
         beta: Tensor<2>,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> Tensor<2> {
         let n = tan.dims()[0];
         assert_eq!(tan_host.len(), n, "FmbrdfNets::lambda: tan_host length");
@@ -118,7 +118,7 @@ impl FmbrdfNets {
         // H200 the segments made FMBRDF's step ten times slower than PyTorch's
         // (`benches/README.md`).
         if crate::device::on_gpu(&tan) {
-            return self.lambda_dense(tan, alpha, beta, precision);
+            return self.lambda_dense(tan, alpha, beta, products);
         }
         let (first, second) = (&self.lambda[0], &self.lambda[1]);
         let row = |k: usize| first.weight.clone().narrow(0, k, 1);
@@ -132,7 +132,7 @@ impl FmbrdfNets {
             _ => None,
         };
         let Some(segments) = segments else {
-            return self.lambda_dense(tan, alpha, beta, precision);
+            return self.lambda_dense(tan, alpha, beta, products);
         };
         let device = tan.device();
         let width = first.bias.dims()[1];
@@ -142,11 +142,11 @@ impl FmbrdfNets {
         );
         let index = Tensor::<1, Int>::from_data(TensorData::new(segments.of_row, [n]), &device);
         let product =
-            |x: Tensor<2>| crate::linear_op::linear(x, second.weight.clone(), None, precision);
+            |x: Tensor<2>| crate::linear_op::linear(x, second.weight.clone(), None, products);
         let p = product(mask.clone() * a);
         let q = product(mask * c);
         let z2 = p.select(0, index.clone()) + tan * q.select(0, index) + second.bias.clone();
-        self.lambda[2..].iter().fold(relu(z2), |h, layer| relu(layer.forward(h, precision)))
+        self.lambda[2..].iter().fold(relu(z2), |h, layer| relu(layer.forward(h, products)))
     }
 
     /// The Smith Lambda of tan(theta) values, every layer a dense product over the rows (the
@@ -160,14 +160,14 @@ impl FmbrdfNets {
         tan: Tensor<2>,
         alpha: Tensor<2>,
         beta: Tensor<2>,
-        precision: MatmulPrecision,
+        products: Products,
     ) -> Tensor<2> {
         let n = tan.dims()[0];
         let x = Tensor::cat(
             vec![alpha.clone().expand([n, 1]), beta.expand([n, 1]), tan.clone(), tan * alpha],
             1,
         );
-        self.lambda.iter().fold(x, |h, layer| relu(layer.forward(h, precision)))
+        self.lambda.iter().fold(x, |h, layer| relu(layer.forward(h, products)))
     }
 
     /// The body-reflection intensity I_b.
@@ -176,18 +176,13 @@ impl FmbrdfNets {
     /// - geometry: `[n, 6]` (see [`super::FmbrdfGeometry::body`]); params: `[n, 4]`
     ///   (eta, alpha, beta, kappa)
     /// - output: `[n, 1]`, >= 0
-    pub fn body(
-        &self,
-        geometry: Tensor<2>,
-        params: Tensor<2>,
-        precision: MatmulPrecision,
-    ) -> Tensor<2> {
+    pub fn body(&self, geometry: Tensor<2>, params: Tensor<2>, products: Products) -> Tensor<2> {
         let geometry =
-            crate::linear_op::linear(geometry, self.body_geometry.clone(), None, precision);
-        let mut h = relu(geometry + self.body_params.forward(params, precision));
+            crate::linear_op::linear(geometry, self.body_geometry.clone(), None, products);
+        let mut h = relu(geometry + self.body_params.forward(params, products));
         let last = self.body.len() - 1;
         for (k, layer) in self.body.iter().enumerate() {
-            h = layer.forward(h, precision);
+            h = layer.forward(h, products);
             if k < last {
                 h = relu(h);
             }
@@ -242,9 +237,9 @@ mod tests {
                 let tan = Tensor::<2>::from_data(TensorData::new(t.clone(), [n, 1]), &device);
                 let w = Tensor::<2>::from_data(TensorData::new(weight.clone(), [n, 1]), &device);
                 let y = if segments {
-                    nets.lambda(tan, &t, a.clone(), b.clone(), MatmulPrecision::F32)
+                    nets.lambda(tan, &t, a.clone(), b.clone(), Products::F32)
                 } else {
-                    nets.lambda_dense(tan, a.clone(), b.clone(), MatmulPrecision::F32)
+                    nets.lambda_dense(tan, a.clone(), b.clone(), Products::F32)
                 };
                 let grads = (y.clone() * w).sum().backward();
                 let ga = values(a.grad(&grads).expect("alpha gradient"))[0];
@@ -279,9 +274,8 @@ mod tests {
         let tan = Tensor::<2>::from_data(TensorData::new(t.to_vec(), [2, 1]), &device);
         let nan = Tensor::<2>::from_data(TensorData::new(vec![f32::NAN], [1, 1]), &device);
         let beta = Tensor::<2>::from_data(TensorData::new(vec![1.0_f32], [1, 1]), &device);
-        let y =
-            values(nets.lambda(tan.clone(), &t, nan.clone(), beta.clone(), MatmulPrecision::F32));
-        let y_ref = values(nets.lambda_dense(tan, nan, beta, MatmulPrecision::F32));
+        let y = values(nets.lambda(tan.clone(), &t, nan.clone(), beta.clone(), Products::F32));
+        let y_ref = values(nets.lambda_dense(tan, nan, beta, Products::F32));
         assert_eq!(y.len(), 2);
         assert!(y.iter().zip(&y_ref).all(|(a, b)| a.to_bits() == b.to_bits()));
     }
