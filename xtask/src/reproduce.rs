@@ -61,6 +61,9 @@ pub fn reproduce(opts: Options) -> Result<()> {
         profile = profile.with_tables(tables)?;
     }
     eprintln!("profile {}: {}", profile.name, profile.description);
+    // The environment's settings are checked before anything is written.
+    let how = execution(&opts)?;
+    let settings = sweep_settings()?;
     // One sweep at a time per output directory, held through the tables; taking it removes
     // the temporary files of a sweep killed in it (run directories busy in another process
     // keep theirs).
@@ -72,8 +75,7 @@ pub fn reproduce(opts: Options) -> Result<()> {
             lock.removed_temporaries
         );
     }
-    let how = execution(&opts)?;
-    let s = sweep::sweep(&profile, &opts.out, &opts.data_root, &how)
+    let s = sweep::sweep_with(&profile, &opts.out, &opts.data_root, &how, &settings)
         .with_context(|| format!("sweep {} into {}", profile.name, opts.out.display()))?;
     print_sweep(&s);
     if let Some(submission) = &s.submission {
@@ -113,8 +115,25 @@ pub fn reproduce(opts: Options) -> Result<()> {
     Ok(())
 }
 
+/// The sweep's own settings: the progress lines (`NEURAL_BRDF_PROGRESS_LINES`, `_SECS`) and
+/// the LBO stage's memory budget (the compute settings' `lbo_memory_gib`), from the environment.
+fn sweep_settings() -> Result<sweep::SweepSettings> {
+    let mut progress = sweep::ProgressLines::default();
+    for (variable, _) in sweep::ProgressLines::VARIABLES {
+        if let Ok(value) = std::env::var(variable) {
+            progress = progress.with_override(variable, &value)?;
+        }
+    }
+    let lbo_memory = experiments::cli::process_compute_settings()?.lbo_memory_bytes();
+    Ok(sweep::SweepSettings { progress, lbo_memory })
+}
+
 /// How the runs are executed: `--slurm`, `--emit-jobs`, `--jobs N` children or in process.
+/// The compute settings come from this process's environment
+/// ([`experiments::cli::process_compute_settings`], checked here for every kind): children,
+/// emitted jobs and Slurm tasks inherit it and read it again.
 fn execution(opts: &Options) -> Result<Execution> {
+    let compute = experiments::cli::process_compute_settings()?;
     anyhow::ensure!(
         opts.slurm.is_none() || opts.emit_jobs.is_none(),
         "--slurm and --emit-jobs are two ways to hand the runs to a cluster: choose one"
@@ -128,7 +147,7 @@ fn execution(opts: &Options) -> Result<Execution> {
         (Some(file), _) => {
             Execution::Emit { file: file.clone(), command: run_one_command(opts.backend)? }
         }
-        (None, 0 | 1) => Execution::InProcess(opts.backend),
+        (None, 0 | 1) => Execution::InProcess(sweep::RunOn { backend: opts.backend, compute }),
         (None, jobs) => Execution::Children { jobs, command: run_one_command(opts.backend)? },
     })
 }
@@ -176,9 +195,8 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<()> {
 pub fn run_one(dir: &Path, progress: bool, backend: Backend) -> Result<()> {
     sweep::exit_with_parent();
     experiments::interrupt::install();
-    match sweep::run_one(dir, progress, backend)
-        .with_context(|| format!("run {}", dir.display()))?
-    {
+    let on = sweep::RunOn { backend, compute: experiments::cli::process_compute_settings()? };
+    match sweep::run_one(dir, progress, &on).with_context(|| format!("run {}", dir.display()))? {
         sweep::RunEnd::Done => Ok(()),
         sweep::RunEnd::Interrupted(step) => {
             match step {

@@ -57,3 +57,35 @@ fn every_subcommand_has_help_and_the_run_commands_match_the_experiments_binary()
         assert_eq!(options(&xtask(&[name, "--help"])), options(&ours), "{name}");
     }
 }
+
+/// The environment's compute settings are read by the command line, once, before any work:
+/// a bad value fails `run-one` and `reproduce-tables` at once, naming the variable and what it
+/// takes, and writes nothing.
+#[test]
+fn a_bad_compute_setting_in_the_environment_is_refused_by_name() {
+    let dir = test_support::TempDir::new("xtask-bad-setting");
+    for (var, value, expected) in [
+        ("NEURAL_BRDF_LOSS_READS", "0", "positive number"),
+        ("CPU_KERNELS_AMX", "maybe", "0 or 1"),
+        ("NEURAL_BRDF_GPU_TILE", "256", "128v"),
+    ] {
+        let out_dir = dir.0.join(var);
+        for args in [
+            vec!["reproduce-tables", "--profile", "smoke", "--out", out_dir.to_str().unwrap()],
+            vec!["run-one", out_dir.to_str().unwrap()],
+        ] {
+            let out = Command::new(env!("CARGO_BIN_EXE_xtask"))
+                .args(&args)
+                .env(var, value)
+                .output()
+                .unwrap();
+            let text = String::from_utf8_lossy(&out.stderr);
+            assert!(!out.status.success(), "{args:?} with {var}={value} succeeded");
+            assert!(text.contains(var) && text.contains(expected), "{args:?}: {text}");
+        }
+        let written: Vec<_> = std::fs::read_dir(&out_dir)
+            .map(|d| d.filter_map(|e| e.ok()).map(|e| e.file_name()).collect())
+            .unwrap_or_default();
+        assert!(written.iter().all(|n| n.to_string_lossy().starts_with('.')), "{var}: {written:?}");
+    }
+}

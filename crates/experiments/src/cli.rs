@@ -11,10 +11,32 @@ use crate::{FitOptions, FitOutcome};
 use anyhow::{Context, Result, bail};
 use brdf_neural::device::Backend;
 use clap::Subcommand;
-use run_format::EnergyEstimator;
 use run_format::config::RunConfig;
 use run_format::run_dir::RunDir;
+use run_format::{ComputeSettings, EnergyEstimator};
 use std::path::{Path, PathBuf};
+
+/// This process's compute settings: the defaults, overridden by those of
+/// [`ComputeSettings::variables`] that are set in the environment (the one place where
+/// environment variables become settings; both command lines call it). Applies what stays
+/// per process before any device is made: the allocator policy of `keep_freed_memory`, and
+/// the GPU kernels' index checks (`gpu.checked`, a debugging aid that changes no value).
+///
+/// # Errors
+/// A variable whose value its setting does not take, named.
+pub fn process_compute_settings() -> Result<ComputeSettings> {
+    let mut settings = ComputeSettings::default();
+    for (variable, _) in ComputeSettings::variables() {
+        if let Ok(value) = std::env::var(variable) {
+            settings = settings.with_override(variable, &value)?;
+        }
+    }
+    if !settings.keep_freed_memory {
+        brdf_neural::host_memory::leave_allocator_alone();
+    }
+    brdf_neural::gpu_linear::launch_checked(settings.gpu.checked);
+    Ok(settings)
+}
 
 /// A command on one run: fit, evaluate, analyse or export it.
 #[derive(Subcommand)]
@@ -225,7 +247,9 @@ fn fit_command(
     if let Some(scene) = scene {
         cfg.scene = Some(std::path::absolute(&scene).unwrap_or(scene));
     }
-    let options = FitOptions { progress: !quiet, cache_dir: cache, backend, ..Default::default() };
+    let compute = process_compute_settings()?;
+    let options =
+        FitOptions { progress: !quiet, cache_dir: cache, backend, compute, ..Default::default() };
     match crate::fit(&cfg, out, options).with_context(|| format!("fit into {}", out.display()))? {
         FitOutcome::AlreadyFinished(m) => {
             println!("{}: already finished ({} steps), skipped", out.display(), m.steps)

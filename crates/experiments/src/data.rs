@@ -289,12 +289,13 @@ pub struct SpatialFeatures {
 }
 
 /// Spatial features of `samples` under `features` ([`SpatialFeatures`]): LBO eigenfunctions
-/// interpolated barycentrically from the mesh's vertex table, or the positions.
+/// interpolated barycentrically from the mesh's vertex table, or the positions. A solve the
+/// cache does not spare may take `lbo_memory` bytes ([`lbo_table`]).
 pub fn spatial_features(
     scene: &SceneDataset,
     samples: &SampleSet,
     features: &FeatureConfig,
-    cache_dir: &Path,
+    (cache_dir, lbo_memory): (&Path, Option<u64>),
 ) -> Result<SpatialFeatures> {
     // Distinct points by the exact bits of what the features are computed from.
     let key = |i: usize| -> [u32; 3] {
@@ -324,7 +325,7 @@ pub fn spatial_features(
         }
         SpatialKind::Uniform => (vec![1.0; first.len()], 1),
         SpatialKind::Lbo => {
-            let (table, dim) = lbo_table(scene, features, cache_dir)?;
+            let (table, dim) = lbo_table(scene, features, cache_dir, lbo_memory)?;
             let mut out = vec![0.0; first.len() * dim];
             let tris = &scene.mesh.triangles;
             for (row, &i) in out.chunks_mut(dim).zip(&first) {
@@ -362,7 +363,8 @@ pub fn vertex_features(
     cache: &Path,
 ) -> Result<(Vec<f32>, usize)> {
     match config.features.spatial {
-        SpatialKind::Lbo => lbo_table(scene, &config.features, cache),
+        // Training or the sweep's feature stage solved it (with their budget) and cached it.
+        SpatialKind::Lbo => lbo_table(scene, &config.features, cache, None),
         SpatialKind::Position => {
             Ok((scene.mesh.positions.iter().flat_map(|p| p.to_array()).collect(), 3))
         }
@@ -372,11 +374,13 @@ pub fn vertex_features(
 
 /// The per-vertex LBO feature table `[vertices, dim]` of the scene's mesh, from
 /// `<cache_dir>/lbo-table-<mesh and solver key>-<selection>.bin` (the workspace's checked cache
-/// container) or computed (then cached).
+/// container) or computed (then cached), the solve's factor within `lbo_memory` bytes (`None`:
+/// mesh-encoding's default budget, [`EigenSettings::memory_budget`]).
 pub fn lbo_table(
     scene: &SceneDataset,
     features: &FeatureConfig,
     cache_dir: &Path,
+    lbo_memory: Option<u64>,
 ) -> Result<(Vec<f32>, usize)> {
     /// Version of the table files; bump when the table's meaning changes.
     const TABLE_VERSION: u32 = 1;
@@ -389,7 +393,7 @@ pub fn lbo_table(
         &vertices,
         &scene.mesh.triangles,
         config.required_pairs(),
-        &eigen_settings(features),
+        &eigen_settings(features, lbo_memory),
     );
     let path = cache_dir.join(format!(
         "lbo-table-{key:032x}-{}-{}-{}-{}.bin",
@@ -402,7 +406,7 @@ pub fn lbo_table(
     {
         return Ok((table, dim));
     }
-    let encoding = lbo_encoding(scene, features, cache_dir)?;
+    let encoding = lbo_encoding(scene, features, cache_dir, lbo_memory)?;
     let table = encoding.as_slice().to_vec();
     stdx::fs::write_atomic(&path, &stdx::cache_file::encode(MAGIC, TABLE_VERSION, key, &table))?;
     Ok((table, encoding.dim()))
@@ -414,23 +418,29 @@ fn encoding_config(features: &FeatureConfig) -> Result<LboEncodingConfig> {
     Ok(LboEncodingConfig { selection: features.lbo.indices()?, ..LboEncodingConfig::default() })
 }
 
-fn eigen_settings(features: &FeatureConfig) -> EigenSettings {
-    EigenSettings { max_basis_factor: features.lbo.max_basis_factor, ..EigenSettings::default() }
+fn eigen_settings(features: &FeatureConfig, memory_budget: Option<u64>) -> EigenSettings {
+    EigenSettings {
+        max_basis_factor: features.lbo.max_basis_factor,
+        memory_budget,
+        ..EigenSettings::default()
+    }
 }
 
 /// The LBO encoding of the scene's mesh with the configured selection, eigenpairs from the
-/// content-keyed cache (mesh-encoding picks the dense solver itself for small meshes).
+/// content-keyed cache (mesh-encoding picks the dense solver itself for small meshes), a solve
+/// within `lbo_memory` bytes ([`lbo_table`]).
 pub fn lbo_encoding(
     scene: &SceneDataset,
     features: &FeatureConfig,
     cache_dir: &Path,
+    lbo_memory: Option<u64>,
 ) -> Result<LboEncoding> {
     let config = encoding_config(features)?;
     let vertices: Vec<[f64; 3]> =
         scene.mesh.positions.iter().map(|p| [p.x as f64, p.y as f64, p.z as f64]).collect();
     std::fs::create_dir_all(cache_dir).map_err(|e| Error::io(cache_dir, e))?;
     let k = config.required_pairs();
-    let settings = eigen_settings(features);
+    let settings = eigen_settings(features, lbo_memory);
     let mesh = scene.dir.join(&scene.manifest.mesh_file);
     let (pairs, _) = cached_eigenpairs(&vertices, &scene.mesh.triangles, k, &settings, cache_dir)
         .map_err(|e| match e {

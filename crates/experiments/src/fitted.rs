@@ -81,7 +81,7 @@ impl FittedRun {
     pub fn test_records(&self) -> Result<(SampleSet, RecordSet)> {
         let samples = self.dataset.samples(Split::Test)?;
         let spatial =
-            spatial_features(&self.dataset, &samples, &self.config.features, &self.cache)?;
+            spatial_features(&self.dataset, &samples, &self.config.features, (&self.cache, None))?;
         let data = RecordSet::new(&samples, &spatial);
         Ok((samples, data))
     }

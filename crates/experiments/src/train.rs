@@ -31,6 +31,7 @@ use burn::module::Module;
 use burn::optim::{AdamConfig, ModuleOptimizer};
 use burn::tensor::Device;
 use indicatif::ProgressBar;
+use run_format::ComputeSettings;
 use run_format::config::RunConfig;
 use run_format::run_dir::{RunDir, RunMetrics, write_curve};
 use run_format::train_config::OutputInit;
@@ -61,11 +62,13 @@ pub struct FitOptions {
     /// ([`brdf_neural::fitted::device_records`]), so that a step uploads only its record indices;
     /// `None`: on GPU backends. The same values either way (tests compare the two on the CPU).
     pub inputs_on_device: Option<bool>,
-    /// Steps between host reads of the training loss; between reads each step's loss stays
-    /// on the device and the host queues the next step at once. `None`: 1 on the CPU,
-    /// [`crate::train_loop::GPU_LOSS_READS`] on GPU backends. The losses and weights do not
-    /// depend on it (a non-finite loss is still named at its step).
-    pub loss_reads: Option<u64>,
+    /// How the run computes beyond its configuration: the bf16 kernel, and the steps between
+    /// host reads of the training loss (`loss_reads`; between reads each step's loss stays on
+    /// the device and the host queues the next step at once; `None`: 1 on the CPU,
+    /// [`crate::train_loop::GPU_LOSS_READS`] on GPU backends; the losses and weights do not
+    /// depend on it, and a non-finite loss is still named at its step). Recorded in
+    /// `metrics.json` (`compute`).
+    pub compute: ComputeSettings,
 }
 
 /// How [`fit`] ended.
@@ -118,14 +121,18 @@ pub struct RunData {
 }
 
 /// Reads the scene and builds the training and validation records (features computed once up
-/// front).
-pub fn training_data(config: &RunConfig, cache_dir: &Path) -> Result<RunData> {
+/// front; an LBO solve the cache does not spare within `lbo_memory` bytes,
+/// [`crate::data::lbo_table`]).
+pub fn training_data(
+    config: &RunConfig,
+    (cache_dir, lbo_memory): (&Path, Option<u64>),
+) -> Result<RunData> {
     let scene_dir = config.scene.as_ref().ok_or_else(|| {
         Error::config("scene", "no scene directory (set `scene` or pass --scene)")
     })?;
     let scene = SceneDataset::open(scene_dir)?;
     let samples = scene.samples(Split::Train)?;
-    let spatial = spatial_features(&scene, &samples, &config.features, cache_dir)?;
+    let spatial = spatial_features(&scene, &samples, &config.features, (cache_dir, lbo_memory))?;
     let t = &config.train;
     let pairs = validation_pairs(&scene, t.validation_fraction);
     let (train, val) = split_validation(&samples, &pairs, t.validation_records, config.seed);
@@ -223,7 +230,8 @@ pub fn fit_and_keep(
         return Ok((FitOutcome::AlreadyFinished(metrics), None));
     }
     let cache = dir.cache(config, options.cache_dir.as_deref());
-    let RunData { scene, train: data, val, val_floor } = training_data(config, &cache)?;
+    let RunData { scene, train: data, val, val_floor } =
+        training_data(config, (&cache, options.compute.lbo_memory_bytes()))?;
     let t = &config.train;
 
     let device = options.backend.training_device()?;
@@ -236,12 +244,15 @@ pub fn fit_and_keep(
     let on_device = options.inputs_on_device.unwrap_or(options.backend.is_gpu());
     let (spatial, val_spatial, records) = device_inputs(config, (&data, &val), on_device, &device)?;
     let gpu_reads = if options.backend.is_gpu() { GPU_LOSS_READS } else { 1 };
-    let loss_reads = options.loss_reads.or(loss_reads_from_env()?).unwrap_or(gpu_reads).max(1);
+    let loss_reads = options.compute.loss_reads.unwrap_or(gpu_reads).max(1);
     // The training steps' products: the run's precision (checked against the backend), and on
     // a GPU the weight gradients' sum over the batch split into parts (split-K), which the
     // GPU's matrix-product kernels do not split themselves. Evaluation keeps plain f32.
-    let products = Products::training(t.matmul_precision, options.backend, t.batch_size)?;
-    warn_of_slow_bf16(run, t.matmul_precision, options.backend);
+    let products = Products::training(t.matmul_precision, options.backend, t.batch_size)?
+        .with_bf16_amx(options.compute.bf16_amx)
+        .with_gpu(options.compute.gpu);
+    products.check(options.backend)?;
+    warn_of_slow_bf16(run, products, options.backend);
     let lp = Loop {
         config,
         run: &dir,
@@ -271,6 +282,7 @@ pub fn fit_and_keep(
     });
     let mut metrics = run_metrics(config, &state, &data, val.len());
     metrics.backend = Some(options.backend);
+    metrics.compute = Some(options.compute.clone());
     metrics.startup_seconds = lp.startup_seconds.get();
     metrics.val_loss_floor = val_floor;
     write_finished_run(&dir, config, (&model, &state), &metrics, (&scene, &cache))?;
@@ -349,8 +361,8 @@ fn device_inputs(
 }
 
 /// Warns when bf16 products on this CPU would be slower than f32 (emulated, or AMX off).
-fn warn_of_slow_bf16(run: &Path, precision: MatmulPrecision, backend: Backend) {
-    if precision != MatmulPrecision::Bf16 || backend.is_gpu() {
+fn warn_of_slow_bf16(run: &Path, products: Products, backend: Backend) {
+    if products.precision != MatmulPrecision::Bf16 || backend.is_gpu() {
         return;
     }
     if !MatmulPrecision::bf16_native() {
@@ -360,7 +372,9 @@ fn warn_of_slow_bf16(run: &Path, precision: MatmulPrecision, backend: Backend) {
              without it); f32 is the faster choice here",
             run.display()
         );
-    } else if MatmulPrecision::cpu_has_amx_bf16() && !MatmulPrecision::bf16_on_amx() {
+    } else if MatmulPrecision::cpu_has_amx_bf16()
+        && !(products.bf16_amx && MatmulPrecision::bf16_on_amx())
+    {
         eprintln!(
             "{}: warning: matmul_precision = \"bf16\" on an Intel CPU with AMX, but the AMX \
              kernel is off (CPU_KERNELS_AMX=0, or Linux refused the tile registers): the products \
@@ -422,23 +436,6 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
     }
 }
 
-/// `NEURAL_BRDF_LOSS_READS`: steps between host reads of the training loss, for runs whose
-/// [`FitOptions::loss_reads`] is unset (`1` reads every step, as the CPU does; the GPU
-/// measurements compare the two).
-fn loss_reads_from_env() -> Result<Option<u64>> {
-    const VAR: &str = "NEURAL_BRDF_LOSS_READS";
-    match std::env::var(VAR) {
-        Err(_) => Ok(None),
-        Ok(v) => match v.trim().parse::<u64>() {
-            Ok(n) if n > 0 => Ok(Some(n)),
-            _ => Err(Error::format(
-                Path::new(VAR),
-                format!("`{v}` is not a positive number of steps between reads of the loss"),
-            )),
-        },
-    }
-}
-
 /// The training progress bar over the step budget, at `position` (hidden unless `visible`).
 fn progress_bar(visible: bool, budget: u64, position: u64) -> ProgressBar {
     let bar = stdx::progress::bar(budget, "steps at most", "train", visible);
@@ -475,5 +472,6 @@ fn run_metrics(
         phases: Some(state.phases.clone()),
         backend: None,
         startup_seconds: None,
+        compute: None,
     }
 }

@@ -286,7 +286,7 @@ fn losses_read_in_windows_train_like_losses_read_every_step() {
     for kind in ["single_mlp", "disney"] {
         let c = config(kind, 50, "validate_every = 15\npatience = 20\n");
         let every = dir.0.join(format!("{kind}-1"));
-        let options = |reads: u64| FitOptions { loss_reads: Some(reads), ..Default::default() };
+        let options = |reads: u64| FitOptions { compute: reads_every(reads), ..Default::default() };
         fit(&c, &every, options(1)).unwrap();
         assert_eq!(curve(&every).len(), 1 + 5 + 2, "{kind}: 5 log rows and 2 validation rows");
         for reads in [7, 45] {
@@ -296,12 +296,35 @@ fn losses_read_in_windows_train_like_losses_read_every_step() {
             assert!(weights(&every) == weights(&run), "{kind}, reads every {reads}: weights");
         }
         let resumed = dir.0.join(format!("{kind}-resumed"));
-        let stop = FitOptions { stop_after: Some(26), loss_reads: Some(7), ..Default::default() };
+        let stop =
+            FitOptions { stop_after: Some(26), compute: reads_every(7), ..Default::default() };
         assert_eq!(fit(&c, &resumed, stop).unwrap(), FitOutcome::Stopped(26));
         fit(&c, &resumed, options(7)).unwrap();
         assert_eq!(curve(&every), curve(&resumed), "{kind}: the resumed run's curve differs");
         assert!(weights(&every) == weights(&resumed), "{kind}: the resumed run's weights");
     }
+}
+
+/// The compute settings reach the products and the record: a bf16 fit with the AMX tiles and
+/// one on the AVX512-BF16 kernel differ in their weights (their sums run in other orders) on a
+/// CPU that has both, and each run's `metrics.json` says which it trained with.
+#[test]
+fn compute_settings_reach_the_products_and_the_record() {
+    let dir = TempDir::new("compute");
+    let weights = |run: &Path| std::fs::read(run.join("weights.bpk")).unwrap();
+    let c = config("single_mlp", 30, "matmul_precision = \"bf16\"\n");
+    let mut runs = Vec::new();
+    for amx in [true, false] {
+        let run = dir.0.join(format!("amx-{amx}"));
+        let compute = run_format::ComputeSettings { bf16_amx: amx, ..Default::default() };
+        fit(&c, &run, FitOptions { compute: compute.clone(), ..Default::default() }).unwrap();
+        let m = run_format::RunMetrics::read(&RunDir::new(&run).metrics()).unwrap();
+        assert_eq!(m.compute, Some(compute), "metrics.json records the settings");
+        runs.push(run);
+    }
+    use brdf_neural::precision::{MatmulPrecision, PrecisionSupport};
+    let both = MatmulPrecision::bf16_on_amx();
+    assert_eq!(weights(&runs[0]) != weights(&runs[1]), both, "AMX on this CPU: {both}");
 }
 
 #[test]
@@ -356,7 +379,7 @@ fn a_non_finite_loss_stops_the_run_and_keeps_the_last_checkpoint() {
             if step == 25 { burn::module::Module::map(model, &mut Poison(false)) } else { model }
         });
         let options =
-            FitOptions { hook: Some(hook), loss_reads: Some(reads), ..Default::default() };
+            FitOptions { hook: Some(hook), compute: reads_every(reads), ..Default::default() };
         let err = fit(&config("disney", 100, ""), &run, options).unwrap_err();
         let msg = err.to_string();
         assert!(matches!(err, Error::NonFinite { step: 25, .. }), "reads {reads}: {msg}");
@@ -428,12 +451,12 @@ fn lbo_features_are_interpolated_and_cached() {
     c.scene = Some(scene().to_path_buf());
     assert_eq!(c.model.spatial_dim, 16);
     let cache = dir.0.join("cache");
-    let first = experiments::train::training_data(&c, &cache).unwrap().train;
+    let first = experiments::train::training_data(&c, (&cache, None)).unwrap().train;
     let files: Vec<_> =
         std::fs::read_dir(&cache).unwrap().map(|e| e.unwrap().file_name()).collect();
     let table = files.iter().find(|f| f.to_string_lossy().starts_with("lbo-table-"));
     assert!(table.is_some(), "{files:?}");
-    let again = experiments::train::training_data(&c, &cache).unwrap().train;
+    let again = experiments::train::training_data(&c, (&cache, None)).unwrap().train;
     assert_eq!(first.spatial, again.spatial);
     assert_eq!(first.point, again.point);
     // One row per distinct surface point: fewer rows than records (a pixel under many lights).
@@ -559,4 +582,9 @@ fn khronos_validator(path: &Path) {
     let report = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{report}{}", String::from_utf8_lossy(&out.stderr));
     assert!(report.contains("\"warnings\": 0"), "{report}");
+}
+
+/// The default compute settings with the training loss read every `reads` steps.
+fn reads_every(reads: u64) -> run_format::ComputeSettings {
+    run_format::ComputeSettings { loss_reads: Some(reads), ..Default::default() }
 }

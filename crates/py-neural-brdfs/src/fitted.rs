@@ -132,7 +132,7 @@ impl Run {
             }
         };
         let r = &self.run;
-        let spatial = spatial_features(&r.dataset, &samples, &r.config.features, &r.cache)
+        let spatial = spatial_features(&r.dataset, &samples, &r.config.features, (&r.cache, None))
             .map_err(run_error)?;
         let points = PointRows { spatial: &spatial.table, dim: spatial.dim, point: &spatial.point };
         let records = Records { points, l: &l, v: &v };

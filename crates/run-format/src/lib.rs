@@ -15,10 +15,13 @@
 //! * [`test_metrics`]: the scores `eval` adds to it; [`metric_settings`]: their exact
 //!   settings per protocol.
 //! * [`phases`]: where a fit's and an evaluation's time goes (step timing).
+//! * [`compute_settings`]: how a run computes beyond its configuration (bf16 kernel, loss
+//!   reads, LBO memory), the CLI's one typed value for what environment variables override.
 //!
 //! The format is an API boundary: the Python package, `collect` and users' scripts read it
 //! (`docs/reproduce.md`, "Run directories").
 
+pub mod compute_settings;
 pub mod config;
 mod error;
 pub mod eval_config;
@@ -30,6 +33,7 @@ pub mod serde_inf;
 pub mod test_metrics;
 pub mod train_config;
 
+pub use compute_settings::ComputeSettings;
 pub use config::{RunConfig, TrainConfig};
 pub use error::{Error, Result};
 pub use eval_config::{EnergyEstimator, EvalConfig, EvalSettings};

@@ -295,6 +295,10 @@ pub struct RunMetrics {
     /// Absent in runs trained before it was recorded, and where the process trained no step.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub startup_seconds: Option<f64>,
+    /// How the last process's fit computed beyond `config.toml` (the bf16 kernel, the loss
+    /// reads; [`crate::ComputeSettings`]). Absent in runs trained before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compute: Option<crate::ComputeSettings>,
 }
 
 impl RunMetrics {

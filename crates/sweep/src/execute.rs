@@ -7,7 +7,7 @@
 //! (resuming from the last checkpoint) and evaluates it. A killed sweep therefore resumes with
 //! nothing lost but the steps since the last checkpoint.
 
-use super::heartbeat::Heartbeat;
+use super::heartbeat::{Heartbeat, ProgressLines};
 use super::plan::{self, Purpose, RunInfo, RunSpec, SceneSource, SceneSpec};
 use super::profile::{CaptureSource, SweepProfile, resolve_mesh};
 use super::shell;
@@ -18,6 +18,7 @@ use experiments::fitted::FittedRun;
 use experiments::train::fit_and_keep;
 use experiments::{Error, FitOptions, FitOutcome, Result};
 use indicatif::ProgressBar;
+use run_format::ComputeSettings;
 use run_format::config::SpatialKind;
 use run_format::run_dir::{RunDir, SweepLayout};
 use scene::SceneDataset;
@@ -29,8 +30,9 @@ use std::time::Instant;
 /// How runs are executed.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Execution {
-    /// One after the other in this process, with progress bars, on this backend.
-    InProcess(Backend),
+    /// One after the other in this process, with progress bars, on this backend and with these
+    /// compute settings.
+    InProcess(RunOn),
     /// `jobs` child processes at a time, each `<program> <args...> <run dir>` (the arguments
     /// carry the backend, e.g. `run-one --backend wgpu`).
     Children {
@@ -55,6 +57,16 @@ pub enum Execution {
         /// The program and leading arguments that run one run directory.
         command: Vec<String>,
     },
+}
+
+/// What the runs a process executes train on: the burn backend, and how they compute beyond
+/// their configuration ([`ComputeSettings`], the CLI's environment overrides).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RunOn {
+    /// The backend of the runs.
+    pub backend: Backend,
+    /// The compute settings of the runs.
+    pub compute: ComputeSettings,
 }
 
 /// What a sweep did.
@@ -128,7 +140,7 @@ pub enum RunEnd {
 /// A failure is also recorded in the run directory ([`crate::status::Failure`], what
 /// `sweep-status` and a cluster's collect job list); the next start clears it. A run another
 /// process works in is refused without a record (that process's start is the one that counts).
-pub fn run_one(run: &Path, progress: bool, backend: Backend) -> Result<RunEnd> {
+pub fn run_one(run: &Path, progress: bool, on: &RunOn) -> Result<RunEnd> {
     if is_done(run) {
         return Ok(RunEnd::Done);
     }
@@ -136,14 +148,15 @@ pub fn run_one(run: &Path, progress: bool, backend: Backend) -> Result<RunEnd> {
         return Err(Error::format(run, format!("in use by {holder}")));
     }
     crate::status::Failure::clear(run);
-    let end = fit_and_evaluate(run, progress, backend);
+    let end = fit_and_evaluate(run, progress, on);
     if let Err(e) = &end {
         crate::status::Failure::record(run, &e.to_string());
     }
     end
 }
 
-fn fit_and_evaluate(run: &Path, progress: bool, backend: Backend) -> Result<RunEnd> {
+fn fit_and_evaluate(run: &Path, progress: bool, on: &RunOn) -> Result<RunEnd> {
+    let backend = on.backend;
     let dir = RunDir::new(run);
     let config = dir.read_config()?;
     let cache = dir.cache(&config, None);
@@ -152,6 +165,7 @@ fn fit_and_evaluate(run: &Path, progress: bool, backend: Backend) -> Result<RunE
         cache_dir: Some(cache.clone()),
         config_from_run_dir: true,
         backend,
+        compute: on.compute.clone(),
         ..Default::default()
     };
     let fitted = match fit_and_keep(&config, run, options)? {
@@ -278,8 +292,14 @@ pub fn prepare_runs(
     Ok(dirs)
 }
 
-/// Computes the LBO tables of every scene's mesh once (cached under `cache`).
-pub fn prepare_features(specs: &[RunSpec], scene_dirs: &[PathBuf], cache: &Path) -> Result<()> {
+/// Computes the LBO tables of every scene's mesh once (cached under `cache`), each solve's
+/// factor within `lbo_memory` bytes (`None`: the solver's default budget).
+pub fn prepare_features(
+    specs: &[RunSpec],
+    scene_dirs: &[PathBuf],
+    cache: &Path,
+    lbo_memory: Option<u64>,
+) -> Result<()> {
     let mut seen = Vec::new();
     for spec in specs {
         if spec.config.features.spatial != SpatialKind::Lbo {
@@ -291,23 +311,28 @@ pub fn prepare_features(specs: &[RunSpec], scene_dirs: &[PathBuf], cache: &Path)
         }
         seen.push(key);
         let scene = SceneDataset::open(&scene_dirs[spec.scene])?;
-        experiments::data::lbo_table(&scene, &spec.config.features, cache)?;
+        experiments::data::lbo_table(&scene, &spec.config.features, cache, lbo_memory)?;
     }
     Ok(())
 }
 
 /// Executes the unfinished runs among `dirs`.
-pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) -> Result<()> {
+pub fn execute(
+    dirs: &[PathBuf],
+    how: &Execution,
+    progress: &ProgressLines,
+    summary: &mut SweepSummary,
+) -> Result<()> {
     let todo: Vec<&PathBuf> = dirs.iter().filter(|d| !is_done(d)).collect();
     summary.skipped = dirs.len() - todo.len();
     let bar = stdx::progress::bar(todo.len() as u64, "runs", "sweep", true);
     let lines = match how {
-        Execution::InProcess(_) => Heartbeat::start(todo.len(), 1),
-        Execution::Children { jobs, .. } => Heartbeat::start(todo.len(), *jobs),
-        Execution::Emit { .. } | Execution::Slurm { .. } => Heartbeat::start(0, 1),
+        Execution::InProcess(_) => Heartbeat::start(todo.len(), 1, progress),
+        Execution::Children { jobs, .. } => Heartbeat::start(todo.len(), *jobs, progress),
+        Execution::Emit { .. } | Execution::Slurm { .. } => Heartbeat::start(0, 1, progress),
     };
     match how {
-        Execution::InProcess(backend) => run_in_process(&todo, *backend, (&bar, &lines), summary),
+        Execution::InProcess(on) => run_in_process(&todo, on, (&bar, &lines), summary),
         Execution::Children { jobs, command } => {
             run_children(&todo, (*jobs, command.as_slice()), (&bar, &lines), summary)?
         }
@@ -324,14 +349,14 @@ pub fn execute(dirs: &[PathBuf], how: &Execution, summary: &mut SweepSummary) ->
 /// Runs `todo` one after the other in this process.
 fn run_in_process(
     todo: &[&PathBuf],
-    backend: Backend,
+    on: &RunOn,
     (bar, lines): (&ProgressBar, &Heartbeat),
     summary: &mut SweepSummary,
 ) {
     for d in todo {
         bar.set_message(short(d));
         lines.started(d);
-        match bar.suspend(|| run_one(d, true, backend)) {
+        match bar.suspend(|| run_one(d, true, on)) {
             Ok(RunEnd::Interrupted(_)) => {
                 summary.failed.push(((*d).clone(), "interrupted by a signal".into()));
                 lines.finished(d, false);
@@ -450,12 +475,34 @@ fn short(d: &Path) -> String {
     d.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
 }
 
-/// Plans, prepares and executes a whole sweep into `out`.
+/// Plans, prepares and executes a whole sweep into `out`, with the default [`SweepSettings`].
 pub fn sweep(
     profile: &SweepProfile,
     out: &Path,
     data_root: &Path,
     how: &Execution,
+) -> Result<SweepSummary> {
+    sweep_with(profile, out, data_root, how, &SweepSettings::default())
+}
+
+/// How a sweep reports its progress and prepares its features, beyond its profile: the
+/// command line's settings (environment variables override them there, and only there).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SweepSettings {
+    /// When and how often the plain progress lines are printed.
+    pub progress: ProgressLines,
+    /// The memory the LBO eigensolver's Cholesky factor may take, in bytes (`None`: three
+    /// quarters of the memory available when a solve starts).
+    pub lbo_memory: Option<u64>,
+}
+
+/// [`sweep`] with `settings`.
+pub fn sweep_with(
+    profile: &SweepProfile,
+    out: &Path,
+    data_root: &Path,
+    how: &Execution,
+    settings: &SweepSettings,
 ) -> Result<SweepSummary> {
     let start = Instant::now();
     let mut summary = SweepSummary::default();
@@ -472,11 +519,11 @@ pub fn sweep(
     let mut timing = SweepTiming { scenes: start.elapsed().as_secs_f64(), ..Default::default() };
     eprintln!("features: LBO tables of {} scene(s)", scene_dirs.len());
     let features = Instant::now();
-    prepare_features(&specs, &scene_dirs, &cache)?;
+    prepare_features(&specs, &scene_dirs, &cache, settings.lbo_memory)?;
     timing.features = features.elapsed().as_secs_f64();
     summary.runs = prepare_runs(&specs, &scenes, &scene_dirs, &runs_dir)?;
     let runs = Instant::now();
-    execute(&summary.runs.clone(), how, &mut summary)?;
+    execute(&summary.runs.clone(), how, &settings.progress, &mut summary)?;
     if let Execution::Slurm { program, backend, options } = how {
         let todo: Vec<PathBuf> = summary.runs.iter().filter(|d| !is_done(d)).cloned().collect();
         // Nothing left to run: no job is submitted, and the tables are made here.

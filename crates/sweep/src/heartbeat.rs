@@ -8,7 +8,8 @@
 //! sweep: 5/27 runs done; running spot__brass__disney__default (step 1200), spot__brass__ts__default (step 400); 12.3 min elapsed, about 31 min left
 //! ```
 //!
-//! `NEURAL_BRDF_PROGRESS_LINES=1` prints them on a terminal too (`0`: never);
+//! When and how often is a [`ProgressLines`] value, the command line's: there
+//! `NEURAL_BRDF_PROGRESS_LINES=1` prints them on a terminal too (`0`: never) and
 //! `NEURAL_BRDF_PROGRESS_SECS` sets the interval (default 30).
 
 use run_format::run_dir::RunDir;
@@ -18,6 +19,58 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
+
+/// When a sweep prints its progress lines, and how often (see the module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ProgressLines {
+    /// `Some(true)`: always, `Some(false)`: never; `None` (the default): when stderr is not a
+    /// terminal.
+    pub wanted: Option<bool>,
+    /// The longest time between two lines (default 30 s, at least 1 s).
+    pub every: Duration,
+}
+
+impl Default for ProgressLines {
+    fn default() -> Self {
+        ProgressLines { wanted: None, every: Duration::from_secs(30) }
+    }
+}
+
+impl ProgressLines {
+    /// The environment variables that override these settings (read by the command line only).
+    pub const VARIABLES: &[(&str, &str)] = &[
+        ("NEURAL_BRDF_PROGRESS_LINES", "1: print the lines on a terminal too, 0: never"),
+        ("NEURAL_BRDF_PROGRESS_SECS", "seconds between two lines at most (default 30)"),
+    ];
+
+    /// These settings with `variable` (one of [`ProgressLines::VARIABLES`]) set from `value`.
+    ///
+    /// # Errors
+    /// A value the variable does not take, or another variable, named.
+    pub fn with_override(mut self, variable: &str, value: &str) -> experiments::Result<Self> {
+        let bad = |expected: &str| {
+            experiments::Error::format(
+                Path::new(variable),
+                format!("`{value}`: expected {expected}"),
+            )
+        };
+        match (variable, value.trim()) {
+            ("NEURAL_BRDF_PROGRESS_LINES", "1") => self.wanted = Some(true),
+            ("NEURAL_BRDF_PROGRESS_LINES", "0") => self.wanted = Some(false),
+            ("NEURAL_BRDF_PROGRESS_LINES", _) => return Err(bad("1 or 0")),
+            ("NEURAL_BRDF_PROGRESS_SECS", v) => match v.parse::<u64>() {
+                Ok(secs) if secs >= 1 => self.every = Duration::from_secs(secs),
+                _ => return Err(bad("a whole number of seconds, at least 1")),
+            },
+            _ => return Err(bad("a progress setting's name")),
+        }
+        Ok(self)
+    }
+
+    fn show(&self) -> bool {
+        self.wanted.unwrap_or_else(|| !std::io::stderr().is_terminal())
+    }
+}
 
 /// What the lines report.
 struct State {
@@ -41,10 +94,11 @@ pub struct Heartbeat {
 }
 
 impl Heartbeat {
-    /// Starts the lines for `total` runs, `jobs` at a time (nothing when they are not wanted).
-    pub fn start(total: usize, jobs: usize) -> Self {
+    /// Starts the lines for `total` runs, `jobs` at a time (nothing when `lines` does not want
+    /// them).
+    pub fn start(total: usize, jobs: usize, lines: &ProgressLines) -> Self {
         let stop = Arc::new(AtomicBool::new(false));
-        if !lines_wanted() || total == 0 {
+        if !lines.show() || total == 0 {
             return Heartbeat { state: None, stop, thread: None };
         }
         let now = Instant::now();
@@ -59,7 +113,7 @@ impl Heartbeat {
             start: now,
             last_line: now,
         }));
-        let every = interval();
+        let every = lines.every.max(Duration::from_secs(1));
         let (s, flag) = (Arc::clone(&state), Arc::clone(&stop));
         let thread = std::thread::spawn(move || {
             while !flag.load(Ordering::Relaxed) {
@@ -117,26 +171,6 @@ impl Drop for Heartbeat {
     }
 }
 
-/// Whether to print the lines: `NEURAL_BRDF_PROGRESS_LINES` (1 or 0), else when stderr is not a
-/// terminal.
-fn lines_wanted() -> bool {
-    match std::env::var("NEURAL_BRDF_PROGRESS_LINES").as_deref() {
-        Ok("1") => true,
-        Ok("0") => false,
-        _ => !std::io::stderr().is_terminal(),
-    }
-}
-
-/// `NEURAL_BRDF_PROGRESS_SECS`, default 30 s, at least 1 s.
-fn interval() -> Duration {
-    let secs = std::env::var("NEURAL_BRDF_PROGRESS_SECS")
-        .ok()
-        .and_then(|v| v.parse::<u64>().ok())
-        .unwrap_or(30)
-        .max(1);
-    Duration::from_secs(secs)
-}
-
 /// A run directory's name without its step budget and id.
 fn name(run: &Path) -> String {
     let n = run.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
@@ -186,6 +220,27 @@ fn line(st: &State) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn progress_settings_parse_and_bad_values_name_the_variable() {
+        let d = ProgressLines::default();
+        assert_eq!((d.wanted, d.every), (None, Duration::from_secs(30)));
+        let on = d.with_override("NEURAL_BRDF_PROGRESS_LINES", "1").unwrap();
+        assert!(on.wanted == Some(true) && on.show());
+        let off = d.with_override("NEURAL_BRDF_PROGRESS_LINES", " 0 ").unwrap();
+        assert!(!off.show());
+        let every = d.with_override("NEURAL_BRDF_PROGRESS_SECS", "5").unwrap();
+        assert_eq!(every.every, Duration::from_secs(5));
+        for (var, bad) in [
+            ("NEURAL_BRDF_PROGRESS_LINES", "yes"),
+            ("NEURAL_BRDF_PROGRESS_SECS", "0"),
+            ("NEURAL_BRDF_PROGRESS_SECS", "soon"),
+            ("NEURAL_BRDF_PROGRESS_NOTHING", "1"),
+        ] {
+            let e = d.with_override(var, bad).unwrap_err().to_string();
+            assert!(e.contains(var), "{e}");
+        }
+    }
 
     #[test]
     fn lines_name_the_runs_their_steps_and_the_time_left() {

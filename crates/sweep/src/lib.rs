@@ -47,5 +47,9 @@ pub mod timing;
 
 pub use collect::collect;
 pub use collected::CollectSummary;
-pub use execute::{Execution, RunEnd, SweepSummary, exit_with_parent, run_one, sweep};
+pub use execute::{
+    Execution, RunEnd, RunOn, SweepSettings, SweepSummary, exit_with_parent, run_one, sweep,
+    sweep_with,
+};
+pub use heartbeat::ProgressLines;
 pub use profile::{DEFAULT_PROFILE, SweepProfile};

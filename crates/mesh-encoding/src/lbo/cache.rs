@@ -71,7 +71,8 @@ pub fn cache_key(
         bytes.extend_from_slice(&i.to_le_bytes());
     }
     bytes.extend_from_slice(&(k as u64).to_le_bytes());
-    // `threads` only changes rounding, so it is not part of the key.
+    // `threads` only changes rounding and `memory_budget` whether a solve may start, so
+    // neither is part of the key.
     let EigenSettings {
         block_size,
         tolerance,
@@ -80,6 +81,7 @@ pub fn cache_key(
         seed,
         slice_size,
         threads: _,
+        memory_budget: _,
     } = *settings;
     bytes.extend_from_slice(&(block_size as u64).to_le_bytes());
     bytes.extend_from_slice(&(slice_size as u64).to_le_bytes());

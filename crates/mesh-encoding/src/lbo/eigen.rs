@@ -79,6 +79,12 @@ pub struct EigenSettings {
     /// only by rounding). Sequential is the default because faer's rayon kernels were slower
     /// than sequential ones on a 2-core machine shared with other jobs (see `PERFORMANCE.md`).
     pub threads: usize,
+    /// The bytes the Cholesky factor (and the Lanczos basis beside it) may take; a solve that
+    /// would need more is refused before it allocates, with a decimation hint. `None` (the
+    /// default): three quarters of the memory available when the solve starts (Linux's
+    /// `MemAvailable`), else 8 GiB. Not part of the cache key (it decides only whether a solve
+    /// may start).
+    pub memory_budget: Option<u64>,
 }
 
 impl EigenSettings {
@@ -102,6 +108,7 @@ impl Default for EigenSettings {
             seed: 0x5eed,
             slice_size: 0,
             threads: 1,
+            memory_budget: None,
         }
     }
 }
@@ -275,7 +282,8 @@ pub fn smallest_eigenpairs(
     let a = shifted_stiffness(matrices, shift)?;
     // The Lanczos basis the solve reserves beside the factor (n x (max_basis + b) values).
     let basis_bytes = (n as u64).saturating_mul((max_basis + b) as u64 * 8);
-    let llt = super::factor::CholeskyFactor::new(a.as_ref(), par, basis_bytes)?;
+    let budget = settings.memory_budget;
+    let llt = super::factor::CholeskyFactor::new(a.as_ref(), par, basis_bytes, budget)?;
     drop(a);
     let factor_seconds = factor_start.elapsed().as_secs_f64();
     let sqrt_m: Vec<f64> = matrices.mass.iter().map(|m| m.sqrt()).collect();

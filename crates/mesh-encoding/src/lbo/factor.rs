@@ -15,16 +15,22 @@ use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, factorize_symboli
 use faer::{Conj, MatMut, Par, Side};
 use std::cell::RefCell;
 
-/// The environment variable that sets the memory the LBO's Cholesky factor may take, in GiB
-/// (default: three quarters of the memory available when the solve starts).
+/// The command line's environment variable that sets
+/// [`EigenSettings::memory_budget`](super::eigen::EigenSettings::memory_budget), in GiB: named in
+/// a refusal's hint (this crate reads no environment).
 pub const MEMORY_BUDGET_VAR: &str = "NEURAL_BRDF_LBO_MEMORY_GIB";
 
-/// Bytes the factor may take: [`MEMORY_BUDGET_VAR`], else 3/4 of `MemAvailable` (Linux), else
-/// 8 GiB; and where that figure came from.
-fn memory_budget() -> (u64, String) {
+/// Bytes the factor may take: `set` (the solver's [`EigenSettings::memory_budget`]), else 3/4
+/// of `MemAvailable` (Linux), else 8 GiB; and where that figure came from.
+///
+/// [`EigenSettings::memory_budget`]: super::eigen::EigenSettings::memory_budget
+fn memory_budget(set: Option<u64>) -> (u64, String) {
     const GIB: f64 = (1u64 << 30) as f64;
-    if let Some(gib) = std::env::var(MEMORY_BUDGET_VAR).ok().and_then(|v| v.parse::<f64>().ok()) {
-        return ((gib * GIB) as u64, format!("{MEMORY_BUDGET_VAR}={gib}"));
+    if let Some(bytes) = set {
+        return (
+            bytes,
+            format!("the budget of {:.1} GiB set ({MEMORY_BUDGET_VAR})", bytes as f64 / GIB),
+        );
     }
     let available = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
         let line = m.lines().find(|l| l.starts_with("MemAvailable:"))?;
@@ -42,8 +48,8 @@ fn memory_budget() -> (u64, String) {
 /// beside it would not fit the memory budget, before anything is allocated: a clear error with a
 /// decimation hint instead of the kernel's out-of-memory kill. The estimate counts the factor's
 /// values and row indices and the numeric factorisation's peak (about as much again).
-fn check_memory(n: usize, nnz: usize, extra: u64) -> Result<()> {
-    let (budget, source) = memory_budget();
+fn check_memory(n: usize, nnz: usize, extra: u64, set: Option<u64>) -> Result<()> {
+    let (budget, source) = memory_budget(set);
     memory_verdict(n, nnz, extra, budget, &source)
 }
 
@@ -79,11 +85,13 @@ pub(crate) struct CholeskyFactor {
 impl CholeskyFactor {
     /// Factors the symmetric positive definite `a` (lower triangle read), fill-reducing
     /// ordering by AMD (faer's default), after checking that the factor and `extra_bytes` the
-    /// caller allocates beside it (the Lanczos basis) fit the memory budget.
+    /// caller allocates beside it (the Lanczos basis) fit the memory budget (`budget`, or the
+    /// default of [`memory_budget`]).
     pub(crate) fn new(
         a: SparseColMatRef<'_, usize, f64>,
         par: Par,
         extra_bytes: u64,
+        budget: Option<u64>,
     ) -> Result<Self> {
         let symbolic = factorize_symbolic_cholesky(
             a.symbolic(),
@@ -92,7 +100,7 @@ impl CholeskyFactor {
             Default::default(),
         )
         .map_err(|e| Error::lbo(format!("symbolic Cholesky failed: {e:?}")))?;
-        check_memory(a.nrows(), symbolic.len_val(), extra_bytes)?;
+        check_memory(a.nrows(), symbolic.len_val(), extra_bytes, budget)?;
         let mut values = vec![0.0; symbolic.len_val()];
         let mut mem = MemBuffer::try_new(
             symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
