@@ -37,6 +37,6 @@ libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     if std::fs::write(dir.join("light_directions.txt"), directions).is_ok()
         && std::fs::write(dir.join("light_intensities.txt"), intensities).is_ok()
     {
-        let _ = dataset_diligent::capture::Capture::open(dir);
+        let _ = dataset_diligent::pms_dir::Capture::open(dir, &stdx::Limits::DEFAULT);
     }
 });

@@ -3,6 +3,6 @@
 libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     let path = std::path::PathBuf::from(format!("/dev/shm/nbrdf-fuzz-{}.png", std::process::id()));
     if std::fs::write(&path, data).is_ok() {
-        let _ = scene::images::read_png_gray(&path);
+        let _ = scene::images::read_png_gray(&path, &stdx::Limits::DEFAULT);
     }
 });

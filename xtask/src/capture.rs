@@ -10,7 +10,8 @@ use std::time::Instant;
 /// writes it beside the scene (`<out>.import-report.json`).
 pub fn import(capture: &Path, out: &Path, progress: bool) -> Result<()> {
     let start = Instant::now();
-    let report = dataset_capture::import_capture(capture, out, progress)
+    let limits = experiments::cli::process_limits()?;
+    let report = dataset_capture::import_capture(capture, out, progress, &limits)
         .with_context(|| format!("importing the capture {}", capture.display()))?;
     println!("| view | split | images | mask px | silhouette px | IoU |");
     println!("| ---: | --- | ---: | ---: | ---: | ---: |");

@@ -16,6 +16,7 @@ pub fn run(
     test_lights: usize,
     target_vertices: usize,
 ) -> Result<()> {
+    let limits = experiments::cli::process_limits()?;
     let multi_view = src.join("view_01").is_dir();
     let report = if multi_view {
         let o = MultiViewOptions {
@@ -23,12 +24,18 @@ pub fn run(
             test_lights,
             target_vertices: Some(target_vertices),
             progress: true,
+            limits,
             ..Default::default()
         };
         import_multi_view(src, out, &o)
     } else {
-        let o =
-            SingleViewOptions { train_lights, test_lights, progress: true, ..Default::default() };
+        let o = SingleViewOptions {
+            train_lights,
+            test_lights,
+            progress: true,
+            limits,
+            ..Default::default()
+        };
         import_single_view(src, out, &o)
     }
     .with_context(|| format!("importing {}", src.display()))?;

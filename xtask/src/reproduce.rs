@@ -115,8 +115,9 @@ pub fn reproduce(opts: Options) -> Result<()> {
     Ok(())
 }
 
-/// The sweep's own settings: the progress lines (`NEURAL_BRDF_PROGRESS_LINES`, `_SECS`) and
-/// the LBO stage's memory budget (the compute settings' `lbo_memory_gib`), from the environment.
+/// The sweep's own settings: the progress lines (`NEURAL_BRDF_PROGRESS_LINES`, `_SECS`), the
+/// LBO stage's memory budget (the compute settings' `lbo_memory_gib`) and the importers' limits
+/// (`stdx::Limits`), from the environment.
 fn sweep_settings() -> Result<sweep::SweepSettings> {
     let mut progress = sweep::ProgressLines::default();
     for (variable, _) in sweep::ProgressLines::VARIABLES {
@@ -125,7 +126,8 @@ fn sweep_settings() -> Result<sweep::SweepSettings> {
         }
     }
     let lbo_memory = experiments::cli::process_compute_settings()?.lbo_memory_bytes();
-    Ok(sweep::SweepSettings { progress, lbo_memory })
+    let limits = experiments::cli::process_limits()?;
+    Ok(sweep::SweepSettings { progress, lbo_memory, limits })
 }
 
 /// How the runs are executed: `--slurm`, `--emit-jobs`, `--jobs N` children or in process.

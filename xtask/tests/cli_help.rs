@@ -89,3 +89,33 @@ fn a_bad_compute_setting_in_the_environment_is_refused_by_name() {
         assert!(written.iter().all(|n| n.to_string_lossy().starts_with('.')), "{var}: {written:?}");
     }
 }
+
+/// The importers' limits are settings of the same kind: a bad value stops `reproduce-tables`,
+/// `import-capture` and `import-diligent` before they read or write anything, naming the
+/// variable.
+#[test]
+fn a_bad_limit_in_the_environment_is_refused_by_name() {
+    let dir = test_support::TempDir::new("xtask-bad-limit");
+    let out_dir = dir.0.join("out");
+    let (o, missing) = (out_dir.to_str().unwrap(), dir.0.join("nothing-here"));
+    let m = missing.to_str().unwrap();
+    for (var, value) in [("NEURAL_BRDF_MAX_IMAGE_PIXELS", "0"), ("NEURAL_BRDF_MAX_ALLOC_MIB", "x")]
+    {
+        for args in [
+            vec!["reproduce-tables", "--profile", "smoke", "--out", o],
+            vec!["import-capture", m, "--out", o],
+            vec!["import-diligent", m, "--out", o],
+        ] {
+            let out = Command::new(env!("CARGO_BIN_EXE_xtask"))
+                .args(&args)
+                .env(var, value)
+                .output()
+                .unwrap();
+            let text = String::from_utf8_lossy(&out.stderr);
+            assert!(!out.status.success(), "{args:?} with {var}={value} succeeded");
+            let named = text.contains(var) && text.contains("positive whole number");
+            assert!(named, "{args:?}: {text}");
+        }
+    }
+    assert!(!out_dir.exists(), "something was written");
+}

@@ -4,6 +4,7 @@
 use crate::config::{ImageSettings, Response};
 use crate::error::{Error, Result};
 use std::path::Path;
+use stdx::Limits;
 
 /// A decoded image: linear radiance (after `scale`) and which pixels have a saturated channel.
 pub struct Decoded {
@@ -24,20 +25,29 @@ fn srgb_to_linear(v: f32) -> f32 {
     if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
 }
 
-/// Decodes an image of the capture, expecting `size`.
-pub fn decode(path: &Path, size: (u32, u32), s: &ImageSettings) -> Result<Decoded> {
+/// What a reader of a capture's image of `size` accepts: no more pixels than its camera
+/// declares (so a header that disagrees is refused before the decoder allocates), and the
+/// user's allocation bound.
+fn within_size(size: (u32, u32), limits: &Limits) -> Limits {
+    Limits { max_image_pixels: u64::from(size.0) * u64::from(size.1), ..*limits }
+}
+
+/// Decodes an image of the capture, expecting `size`, within `limits`.
+pub fn decode(
+    path: &Path,
+    size: (u32, u32),
+    s: &ImageSettings,
+    limits: &Limits,
+) -> Result<Decoded> {
     if !path.exists() {
         return Err(Error::input(path, "the image is missing"));
     }
+    let limits = within_size(size, limits);
     let (w, h, linear, saturation) = if is_exr(path) {
-        let (w, h, px) = scene::images::read_exr_rgb(path)?;
+        let (w, h, px) = scene::images::read_exr_rgb(path, &limits)?;
         (w as u32, h as u32, px, s.saturation.unwrap_or(f32::INFINITY))
     } else {
-        let img = image::ImageReader::open(path)
-            .map_err(|e| Error::io(path, e))?
-            .with_guessed_format()
-            .map_err(|e| Error::io(path, e))?
-            .decode()
+        let img = scene::images::decode_within(path, &limits)
             .map_err(|e| Error::input(path, format!("cannot decode the image: {e}")))?;
         let (w, h) = (img.width(), img.height());
         let rgb = img.into_rgb16();
@@ -73,16 +83,13 @@ pub fn decode(path: &Path, size: (u32, u32), s: &ImageSettings) -> Result<Decode
     Ok(Decoded { size: (w, h), radiance, saturated })
 }
 
-/// Reads a mask PNG of `size`: true where the mask is non-zero (its alpha where it has one).
-pub fn decode_mask(path: &Path, size: (u32, u32)) -> Result<Vec<bool>> {
+/// Reads a mask PNG of `size` within `limits`: true where the mask is non-zero (its alpha where
+/// it has one).
+pub fn decode_mask(path: &Path, size: (u32, u32), limits: &Limits) -> Result<Vec<bool>> {
     if !path.exists() {
         return Err(Error::input(path, "the mask is missing"));
     }
-    let img = image::ImageReader::open(path)
-        .map_err(|e| Error::io(path, e))?
-        .with_guessed_format()
-        .map_err(|e| Error::io(path, e))?
-        .decode()
+    let img = scene::images::decode_within(path, &within_size(size, limits))
         .map_err(|e| Error::input(path, format!("cannot decode the mask: {e}")))?;
     if (img.width(), img.height()) != size {
         return Err(Error::input(
@@ -128,14 +135,19 @@ mod tests {
             scale: 2.0,
             ..Default::default()
         };
-        let d = decode(&p, (2, 1), &s).unwrap();
+        let d = decode(&p, (2, 1), &s, &Limits::DEFAULT).unwrap();
         assert_eq!(d.radiance[0][0], 0.0);
         assert!((d.radiance[0][1] - 2.0 * (128.0_f32 / 255.0).powi(2)).abs() < 1e-5);
         assert_eq!(d.saturated, vec![true, true]);
-        let e = decode(&p, (3, 1), &s).err().unwrap().to_string();
+        let e = decode(&p, (3, 1), &s, &Limits::DEFAULT).err().unwrap().to_string();
         assert!(e.contains("a.png") && e.contains("2 x 1"), "{e}");
-        let e = decode(&dir.join("b.png"), (2, 1), &s).err().unwrap().to_string();
+        let e = decode(&dir.join("b.png"), (2, 1), &s, &Limits::DEFAULT).err().unwrap().to_string();
         assert!(e.contains("b.png") && e.contains("missing"), "{e}");
+        // A header larger than its camera is refused before the decoder allocates.
+        let e = decode(&p, (1, 1), &s, &Limits::DEFAULT).err().unwrap().to_string();
+        assert!(e.contains("a.png") && e.contains("declares 2 x 1 pixels"), "{e}");
+        let e = decode_mask(&p, (1, 1), &Limits::DEFAULT).err().unwrap().to_string();
+        assert!(e.contains("a.png") && e.contains("at most 1"), "{e}");
         std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -22,6 +22,7 @@ use scene::{flag, shading};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
+use stdx::Limits;
 
 /// How one view's mask and the mesh's silhouette agree.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -55,14 +56,24 @@ struct CaptureView {
     mask: Option<Vec<bool>>,
 }
 
-/// Imports the capture in `dir` (its `capture.toml`) as a scene directory at `out`.
-pub fn import_capture(dir: &Path, out: &Path, progress: bool) -> Result<ImportReport> {
+/// Imports the capture in `dir` (its `capture.toml`) as a scene directory at `out`, reading
+/// its images within `limits` (the cameras' image size is checked against them first; each
+/// image and mask must then declare that size before it is decoded).
+pub fn import_capture(
+    dir: &Path,
+    out: &Path,
+    progress: bool,
+    limits: &Limits,
+) -> Result<ImportReport> {
     let config = CaptureConfig::read(dir)?;
     let frames = cameras::read(&config)?;
     let lights = Lights::read(&config.lights)?;
     check_counts(&config, &frames, &lights)?;
-    let views = group_views(&config, &frames, &lights)?;
     let size = image_size(&config, &frames)?;
+    limits
+        .check_pixels(u64::from(size.0), u64::from(size.1))
+        .map_err(|e| Error::input(&config.cameras, format!("the cameras' image size: {e}")))?;
+    let views = group_views(&config, &frames, &lights, limits)?;
     let loaded = mesh_encoding::load_mesh(&config.mesh, &mesh_encoding::LoadOptions::default())?;
     let mesh = loaded.mesh;
     let (min, max) = mesh.bounding_box();
@@ -109,7 +120,7 @@ pub fn import_capture(dir: &Path, out: &Path, progress: bool) -> Result<ImportRe
         }
         let v = &views[vi];
         let f = &frames[v.frames[li]];
-        pair_images(f, &config, v.mask.as_deref(), &infos[vi].lights[li], g, li)
+        pair_images(f, &config, v.mask.as_deref(), &infos[vi].lights[li], (g, li), limits)
     };
     let label = format!("importing capture {object}");
     let contents = SceneContents {
@@ -285,6 +296,7 @@ fn group_views(
     config: &CaptureConfig,
     frames: &[Frame],
     lights: &Lights,
+    limits: &Limits,
 ) -> Result<Vec<CaptureView>> {
     let same = |a: &Frame, b: &Frame| {
         let close = |x: &[f64], y: &[f64]| {
@@ -329,7 +341,7 @@ fn group_views(
         let mut mask: Option<Vec<bool>> = None;
         for &i in &g {
             if let Some(path) = &frames[i].mask {
-                let m = decode_mask(path, frames[i].size)?;
+                let m = decode_mask(path, frames[i].size, limits)?;
                 mask = Some(match mask {
                     None => m,
                     Some(prev) => prev.iter().zip(&m).map(|(a, b)| *a && *b).collect(),
@@ -379,10 +391,10 @@ fn pair_images(
     config: &CaptureConfig,
     mask: Option<&[bool]>,
     light: &LightInfo,
-    g: &ViewPrecompute,
-    li: usize,
+    (g, li): (&ViewPrecompute, usize),
+    limits: &Limits,
 ) -> Result<PairImages> {
-    let img = decode(&frame.image, frame.size, &config.image)?;
+    let img = decode(&frame.image, frame.size, &config.image, limits)?;
     let n_pix = img.radiance.len();
     let inside = |p: usize| mask.is_none_or(|m| m[p]);
     let mut observed = vec![[0.0_f32; 3]; n_pix];

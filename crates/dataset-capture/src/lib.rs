@@ -20,6 +20,7 @@
 //!     std::path::Path::new("my-capture"),
 //!     std::path::Path::new("scenes/my-object"),
 //!     true,
+//!     &stdx::Limits::default(),
 //! )?;
 //! for (i, v) in report.views.iter().enumerate() {
 //!     println!("view {i}: IoU {:?}", v.iou);

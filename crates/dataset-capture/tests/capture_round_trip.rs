@@ -55,7 +55,7 @@ fn a_point_lit_scene_survives_export_and_import() {
     let capture = dir.0.join("capture");
     export_capture(&original, &capture).unwrap();
     let imported = dir.0.join("imported");
-    let report = import_capture(&capture, &imported, false).unwrap();
+    let report = import_capture(&capture, &imported, false, &stdx::Limits::DEFAULT).unwrap();
     let a = SceneDataset::open(&original).unwrap();
     let b = SceneDataset::open(&imported).unwrap();
     assert!(a.manifest.views[0].lights[0].position.is_some(), "the scene has point lights");
@@ -103,8 +103,13 @@ fn a_point_lit_scene_survives_export_and_import() {
 
 /// Imports `capture` into a fresh `out` and returns the error text, checking nothing was written.
 fn refused(capture: &Path, what: &str) -> String {
+    refused_within(capture, what, &stdx::Limits::DEFAULT)
+}
+
+/// [`refused`] within `limits`.
+fn refused_within(capture: &Path, what: &str, limits: &stdx::Limits) -> String {
     let out = capture.with_file_name(format!("out-{}", what.replace(' ', "-")));
-    let e = match import_capture(capture, &out, false) {
+    let e = match import_capture(capture, &out, false, limits) {
         Ok(_) => panic!("{what}: the import succeeded"),
         Err(e) => e.to_string(),
     };
@@ -149,6 +154,16 @@ fn bad_captures_are_refused_naming_the_file_and_the_fault() {
     let capture = dir.0.join("capture");
     export_capture(&original, &capture).unwrap();
 
+    // Images larger than the caller's limits, refused from the cameras' size before any image
+    // is decoded.
+    let (w, h) = {
+        let m = SceneDataset::open(&original).unwrap().manifest;
+        (m.config.settings.width, m.config.settings.height)
+    };
+    let tight = stdx::Limits { max_image_pixels: u64::from(w * h) - 1, ..Default::default() };
+    let e = refused_within(&capture, "beyond the limits", &tight);
+    assert!(e.contains("transforms.json") && e.contains(&format!("{w} x {h} pixels")), "{e}");
+
     // A missing image.
     let c = copy_of(&capture, "missing");
     std::fs::remove_file(c.join("images/v01_l00.exr")).unwrap();
@@ -176,7 +191,7 @@ fn bad_captures_are_refused_naming_the_file_and_the_fault() {
     // NaN pixels.
     let c = copy_of(&capture, "nan");
     let p = c.join("images/v00_l00.exr");
-    let (w, h, mut px) = scene::images::read_exr_rgb(&p).unwrap();
+    let (w, h, mut px) = scene::images::read_exr_rgb(&p, &stdx::Limits::DEFAULT).unwrap();
     px[w * 3 + 5][1] = f32::NAN;
     scene::images::write_exr_rgb(&p, w, h, &px).unwrap();
     let e = refused(&c, "nan pixels");

@@ -15,6 +15,7 @@ use crate::error::{Error, Result};
 use crate::mat5::MatFile;
 use glam::{DMat3, DVec3};
 use std::path::Path;
+use stdx::Limits;
 
 /// Largest |R R^T - I| entry that is factored rather than refused.
 const MAX_NON_ORTHONORMAL: f64 = 0.05;
@@ -57,14 +58,14 @@ fn rq(r: DMat3) -> Option<(DMat3, DMat3)> {
 }
 
 impl Calibration {
-    /// Reads the cameras of views 1..=`views` from `path`; `offset` is added to the principal
-    /// point.
+    /// Reads the cameras of views 1..=`views` from `path` (within `limits`); `offset` is added
+    /// to the principal point.
     ///
     /// # Errors
     /// [`Error::Mat`] naming the file and the variable: missing, wrong shape, not finite, `KK`
     /// not upper triangular, `Rc_i` not (nearly) a rotation.
-    pub fn read(path: &Path, views: usize, offset: f64) -> Result<Self> {
-        let mat = MatFile::read(path)?;
+    pub fn read(path: &Path, views: usize, offset: f64, limits: &Limits) -> Result<Self> {
+        let mat = MatFile::read(path, limits)?;
         let fault = |f: String| Error::Mat { path: path.into(), fault: f };
         let kk = mat.matrix(&["KK"], 3, 3)?;
         if kk.iter().any(|x| !x.is_finite())

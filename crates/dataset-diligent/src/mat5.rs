@@ -21,6 +21,7 @@
 
 use crate::error::{Error, Result};
 use std::path::{Path, PathBuf};
+use stdx::Limits;
 
 /// The class of a MATLAB array.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -149,12 +150,12 @@ const MI_MATRIX: u32 = 14;
 const MI_COMPRESSED: u32 = 15;
 const MI_UTF8: u32 = 16;
 
-/// Largest decompressed variable accepted (1 GiB; guards against corrupt length fields).
-const MAX_INFLATED: usize = 1 << 30;
-
 struct Reader<'a> {
     path: &'a Path,
     big_endian: bool,
+    /// A compressed variable inflates to at most `limits.max_alloc` bytes (a guard against
+    /// corrupt length fields).
+    limits: &'a Limits,
 }
 
 /// One element: its type and data bytes, and the offset just past it.
@@ -171,7 +172,7 @@ impl Reader<'_> {
 
     /// Inflates a compressed variable (a zlib stream holding one miMATRIX element) no further
     /// than the size its own tag declares: the first 8 bytes are inflated alone, and the rest
-    /// is limited to that size (at most [`MAX_INFLATED`]), so a zlib bomb allocates no more
+    /// is limited to that size (at most the limits' `max_alloc`), so a zlib bomb allocates no more
     /// than its tag admits (and the matrix parser checks that against the declared shape).
     fn inflate(&self, data: &[u8], at: usize) -> Result<Vec<u8>> {
         use miniz_oxide::inflate::{TINFLStatus, decompress_to_vec_zlib_with_limit};
@@ -187,11 +188,7 @@ impl Reader<'_> {
         }
         let declared = self.u32_at(&head, 4)? as usize;
         let limit = 8 + declared.next_multiple_of(8);
-        if limit > MAX_INFLATED {
-            return Err(fault(format!(
-                "declares {declared} bytes, more than the {MAX_INFLATED} accepted"
-            )));
-        }
+        self.limits.check_alloc(declared as u64, "its tag").map_err(fault)?;
         // The whole stream, checksum included, within the declared size.
         decompress_to_vec_zlib_with_limit(data, limit).map_err(|e| match e.status {
             TINFLStatus::HasMoreOutput => fault(format!(
@@ -322,14 +319,14 @@ impl Reader<'_> {
 }
 
 impl MatFile {
-    /// Reads and parses a MAT file.
-    pub fn read(path: &Path) -> Result<Self> {
+    /// Reads and parses a MAT file within `limits`.
+    pub fn read(path: &Path, limits: &Limits) -> Result<Self> {
         let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-        Self::parse(&bytes, path)
+        Self::parse(&bytes, path, limits)
     }
 
-    /// Parses MAT file bytes; `path` names them in messages.
-    pub fn parse(bytes: &[u8], path: &Path) -> Result<Self> {
+    /// Parses MAT file bytes within `limits`; `path` names them in messages.
+    pub fn parse(bytes: &[u8], path: &Path, limits: &Limits) -> Result<Self> {
         let fault = |f: String| Error::Mat { path: path.into(), fault: f };
         if bytes.len() < 128 {
             return Err(fault(format!("{} bytes, shorter than the 128-byte header", bytes.len())));
@@ -349,7 +346,7 @@ impl MatFile {
                 )));
             }
         };
-        let r = Reader { path, big_endian };
+        let r = Reader { path, big_endian, limits };
         let version = if big_endian {
             u16::from_be_bytes([bytes[124], bytes[125]])
         } else {
@@ -491,7 +488,7 @@ mod tests {
                 ],
                 compress,
             );
-            let f = MatFile::parse(&bytes, Path::new("t.mat")).unwrap();
+            let f = MatFile::parse(&bytes, Path::new("t.mat"), &Limits::DEFAULT).unwrap();
             assert_eq!(f.variables.len(), 2);
             assert_eq!(
                 f.matrix(&["KK"], 3, 3).unwrap(),
@@ -527,21 +524,21 @@ mod tests {
         b.extend_from_slice(&MI_MATRIX.to_be_bytes());
         b.extend_from_slice(&(m.len() as u32).to_be_bytes());
         b.extend_from_slice(&m);
-        let f = MatFile::parse(&b, Path::new("be.mat")).unwrap();
+        let f = MatFile::parse(&b, Path::new("be.mat"), &Limits::DEFAULT).unwrap();
         assert_eq!(f.vector(&["Tc_1", "Tc"], 3).unwrap(), [7.0, 8.0, 255.0]);
     }
 
     #[test]
     fn bad_files_are_clear_errors() {
         let p = Path::new("bad.mat");
-        let msg = |b: &[u8]| MatFile::parse(b, p).unwrap_err().to_string();
+        let msg = |b: &[u8]| MatFile::parse(b, p, &Limits::DEFAULT).unwrap_err().to_string();
         assert!(msg(b"short").contains("128-byte header"));
         let mut h = vec![b' '; 128];
         assert!(msg(&h).contains("endian"));
         h[..10].copy_from_slice(b"MATLAB 7.3");
         assert!(msg(&h).contains("HDF5"));
         let good = write_mat5(&[("Rc_1", &[3, 2], &[0.0; 6])], false);
-        let f = MatFile::parse(&good, p).unwrap();
+        let f = MatFile::parse(&good, p, &Limits::DEFAULT).unwrap();
         let e = f.matrix(&["Rc_1"], 3, 3).unwrap_err().to_string();
         assert!(e.contains("bad.mat") && e.contains("Rc_1") && e.contains("3 x 2"), "{e}");
         assert!(f.matrix(&["KK"], 3, 3).unwrap_err().to_string().contains("no variable `KK`"));

@@ -33,6 +33,7 @@ use glam::DMat3;
 use scene::Split;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use stdx::Limits;
 
 /// Options of [`import_multi_view`].
 ///
@@ -49,6 +50,7 @@ use std::time::Instant;
 /// | `saturation_level` | 65535 | raw value at which a channel counts as saturated |
 /// | `shadow_bias_relative` | 1e-4 | shadow-ray offset, fraction of the mesh diagonal |
 /// | `progress` | false | progress bars |
+/// | `limits` | `Limits::DEFAULT` | what the image and MAT readers accept (`stdx::Limits`) |
 #[derive(Clone, Debug, PartialEq)]
 pub struct MultiViewOptions {
     /// Number of views expected.
@@ -75,6 +77,8 @@ pub struct MultiViewOptions {
     pub shadow_bias_relative: f32,
     /// Progress bars.
     pub progress: bool,
+    /// What the image and MAT readers accept.
+    pub limits: Limits,
 }
 
 impl Default for MultiViewOptions {
@@ -92,6 +96,7 @@ impl Default for MultiViewOptions {
             saturation_level: 65535,
             shadow_bias_relative: 1e-4,
             progress: false,
+            limits: Limits::DEFAULT,
         }
     }
 }
@@ -119,16 +124,16 @@ fn rows(m: DMat3) -> [[f32; 3]; 3] {
     [t.x_axis, t.y_axis, t.z_axis].map(|r| r.as_vec3().to_array())
 }
 
-/// Opens the captures of views 1..=`views` (`view_VV/`), which must agree in light count and
-/// image size.
-fn open_views(src: &Path, views: usize) -> Result<Vec<Capture>> {
+/// Opens the captures of views 1..=`views` (`view_VV/`) within `limits`, which must agree in
+/// light count and image size.
+fn open_views(src: &Path, views: usize, limits: &Limits) -> Result<Vec<Capture>> {
     let mut captures: Vec<Capture> = Vec::with_capacity(views);
     for v in 1..=views {
         let dir = src.join(format!("view_{v:02}"));
         if !dir.is_dir() {
             return Err(Error::input(&dir, format!("view {v} of {views} is missing")));
         }
-        let c = Capture::open(&dir)?;
+        let c = Capture::open(&dir, limits)?;
         if let Some(first) = captures.first() {
             if c.len() != first.len() {
                 return Err(Error::input(
@@ -192,16 +197,16 @@ pub fn import_multi_view(src: &Path, out: &Path, o: &MultiViewOptions) -> Result
         return Err(Error::input(src, "object directory is missing"));
     }
     let is_train = train_views(o.views, o.train_views.as_deref())?;
-    let captures = open_views(src, o.views)?;
+    let captures = open_views(src, o.views, &o.limits)?;
     let (train, test) = split_lights(captures[0].len(), o.train_lights, o.test_lights, o.seed)?;
 
     let calib_path = o.calibration.clone().unwrap_or_else(|| src.join("Calib_Results.mat"));
-    let calib = Calibration::read(&calib_path, o.views, o.principal_point_offset)?;
+    let calib = Calibration::read(&calib_path, o.views, o.principal_point_offset, &o.limits)?;
     let mut warnings = calib.warnings.clone();
     // Ground-truth normal maps of the views, when shipped, read before anything is written.
     let normal_maps = captures
         .iter()
-        .map(|c| read_normal_map(&c.dir, c.width, c.height))
+        .map(|c| read_normal_map(&c.dir, c.width, c.height, &o.limits))
         .collect::<Result<Vec<_>>>()?;
 
     let mesh_path = match &o.mesh {

@@ -10,17 +10,24 @@ use crate::report::NormalCheck;
 use glam::{DVec3, Mat3};
 use raycast_precompute::ViewPrecompute;
 use std::path::Path;
+use stdx::Limits;
 
 /// The ground-truth normal map file of a capture directory.
 pub const NORMAL_GT: &str = "Normal_gt.mat";
 
-/// Reads `dir/Normal_gt.mat` when present and checks it is `height` x `width` x 3.
-pub fn read_normal_map(dir: &Path, width: u32, height: u32) -> Result<Option<MatVariable>> {
+/// Reads `dir/Normal_gt.mat` when present (within `limits`) and checks it is `height` x `width`
+/// x 3.
+pub fn read_normal_map(
+    dir: &Path,
+    width: u32,
+    height: u32,
+    limits: &Limits,
+) -> Result<Option<MatVariable>> {
     let path = dir.join(NORMAL_GT);
     if !path.is_file() {
         return Ok(None);
     }
-    let mat = MatFile::read(&path)?;
+    let mat = MatFile::read(&path, limits)?;
     let var = mat.numeric(&["Normal_gt"])?.clone();
     let (h, w) = (height as usize, width as usize);
     if var.dims != [h, w, 3] {

@@ -19,6 +19,7 @@
 
 use crate::error::{Error, Result};
 use std::path::{Path, PathBuf};
+use stdx::Limits;
 
 /// Light directions file name.
 pub const LIGHT_DIRECTIONS: &str = "light_directions.txt";
@@ -56,6 +57,8 @@ pub struct Capture {
     pub directions: Vec<[f64; 3]>,
     /// Light intensities, RGB, each finite and > 0.
     pub intensities: Vec<[f64; 3]>,
+    /// What the image reader accepts: the caller's limits, with no image larger than the mask.
+    pub limits: Limits,
 }
 
 /// Reads a text file of rows of three numbers (blank lines ignored).
@@ -86,11 +89,13 @@ fn image_err(path: &Path, e: impl std::fmt::Display) -> Error {
     Error::input(path, format!("cannot decode image: {e}"))
 }
 
-/// Decodes a 16-bit RGB (or RGBA, alpha dropped, or gray) PNG: (width, height, pixels).
-pub fn read_png16(path: &Path) -> Result<(u32, u32, Vec<[u16; 3]>)> {
-    let reader = image::ImageReader::open(path).map_err(|e| Error::io(path, e))?;
-    let img = reader.with_guessed_format().map_err(|e| Error::io(path, e))?.decode();
-    let img = img.map_err(|e| image_err(path, e))?;
+/// Decodes a 16-bit RGB (or RGBA, alpha dropped, or gray) PNG within `limits`: (width,
+/// height, pixels).
+pub fn read_png16(path: &Path, limits: &Limits) -> Result<(u32, u32, Vec<[u16; 3]>)> {
+    if !path.is_file() {
+        return Err(Error::input(path, "image is missing"));
+    }
+    let img = scene::images::decode_within(path, limits).map_err(|e| image_err(path, e))?;
     let (w, h) = (img.width(), img.height());
     let px: Vec<[u16; 3]> = match img {
         image::DynamicImage::ImageRgb16(b) => b.pixels().map(|p| p.0).collect(),
@@ -108,9 +113,14 @@ pub fn read_png16(path: &Path) -> Result<(u32, u32, Vec<[u16; 3]>)> {
     Ok((w, h, px))
 }
 
-/// Decodes a mask PNG of any colour type: foreground where any channel is at least half scale.
-pub fn read_mask(path: &Path) -> Result<(u32, u32, Vec<bool>)> {
-    let img = image::open(path).map_err(|e| image_err(path, e))?.into_rgb8();
+/// Decodes a mask PNG of any colour type within `limits`: foreground where any channel is at
+/// least half scale.
+pub fn read_mask(path: &Path, limits: &Limits) -> Result<(u32, u32, Vec<bool>)> {
+    if !path.is_file() {
+        return Err(Error::input(path, "mask is missing"));
+    }
+    let img = scene::images::decode_within(path, limits).map_err(|e| image_err(path, e))?;
+    let img = img.into_rgb8();
     let (w, h) = img.dimensions();
     Ok((w, h, img.pixels().map(|p| p.0.iter().any(|&c| c >= 128)).collect()))
 }
@@ -209,20 +219,22 @@ fn check_image_sizes(images: &[PathBuf], mask_path: &Path, width: u32, height: u
 }
 
 impl Capture {
-    /// Opens and checks a capture directory (light files, mask, and every image's header).
-    pub fn open(dir: &Path) -> Result<Self> {
+    /// Opens and checks a capture directory (light files, mask, and every image's header),
+    /// whose images are read within `limits`.
+    pub fn open(dir: &Path, limits: &Limits) -> Result<Self> {
         if !dir.is_dir() {
             return Err(Error::input(dir, "capture directory is missing"));
         }
         let (directions, intensities) = read_lights(dir)?;
         let images = image_paths(dir, directions.len())?;
         let mask_path = dir.join(MASK);
-        let (width, height, mask) = read_mask(&mask_path)?;
+        let (width, height, mask) = read_mask(&mask_path, limits)?;
         if !mask.iter().any(|&m| m) {
             return Err(Error::input(&mask_path, "the mask is empty"));
         }
         check_image_sizes(&images, &mask_path, width, height)?;
-        Ok(Self { dir: dir.into(), width, height, mask, images, directions, intensities })
+        let limits = Limits { max_image_pixels: u64::from(width) * u64::from(height), ..*limits };
+        Ok(Self { dir: dir.into(), width, height, mask, images, directions, intensities, limits })
     }
 
     /// Number of lights (images).
@@ -238,7 +250,7 @@ impl Capture {
     /// The raw 16-bit image of light `i` (0-based), row-major.
     pub fn raw_image(&self, i: usize) -> Result<Vec<[u16; 3]>> {
         let path = &self.images[i];
-        let (w, h, px) = read_png16(path)?;
+        let (w, h, px) = read_png16(path, &self.limits)?;
         if (w, h) != (self.width, self.height) {
             return Err(Error::input(
                 path,

@@ -22,6 +22,7 @@ use glam::{DMat3, Mat3};
 use scene::Split;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use stdx::Limits;
 
 /// DiLiGenT's calibrated intrinsics of its 612 x 512 images: fx, fy, cx, cy in pixels, with the
 /// principal point in the convention where pixel centres are integers (OpenCV's). Source: the
@@ -43,6 +44,7 @@ pub const DILIGENT_INTRINSICS: [f64; 4] =
 /// | `saturation_level` | 65535 | raw 16-bit value at which a channel counts as saturated |
 /// | `shadow_bias_relative` | 1e-4 | shadow-ray offset, fraction of the mesh diagonal |
 /// | `progress` | false | show a progress bar |
+/// | `limits` | `Limits::DEFAULT` | what the image and MAT readers accept (`stdx::Limits`) |
 #[derive(Clone, Debug, PartialEq)]
 pub struct SingleViewOptions {
     /// Training lights.
@@ -63,6 +65,8 @@ pub struct SingleViewOptions {
     pub shadow_bias_relative: f32,
     /// Progress bar.
     pub progress: bool,
+    /// What the image and MAT readers accept.
+    pub limits: Limits,
 }
 
 impl Default for SingleViewOptions {
@@ -77,6 +81,7 @@ impl Default for SingleViewOptions {
             saturation_level: 65535,
             shadow_bias_relative: 1e-4,
             progress: false,
+            limits: Limits::DEFAULT,
         }
     }
 }
@@ -113,7 +118,7 @@ pub fn import_single_view(src: &Path, out: &Path, o: &SingleViewOptions) -> Resu
     {
         return Err(Error::option("intrinsics", format!("{:?} is not a camera", o.intrinsics)));
     }
-    let capture = Capture::open(src)?;
+    let capture = Capture::open(src, &o.limits)?;
     let object = object_name(src);
     if object != "ball" {
         return Err(Error::input(
@@ -131,7 +136,7 @@ pub fn import_single_view(src: &Path, out: &Path, o: &SingleViewOptions) -> Resu
     let k64 = DMat3::from_cols_array_2d(&k.map(|r| r.map(f64::from))).transpose();
     let t = sphere_translation(k64, &circle);
     // The ground-truth normal map, read (and checked) before anything is written.
-    let gt = read_normal_map(src, capture.width, capture.height)?;
+    let gt = read_normal_map(src, capture.width, capture.height, &o.limits)?;
     let (train, test) = split_lights(capture.len(), o.train_lights, o.test_lights, o.seed)?;
     let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     let t32 = t.as_vec3().to_array();

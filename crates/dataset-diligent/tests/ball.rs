@@ -12,7 +12,7 @@ use scene::{MaterialSpec, Split};
 #[test]
 fn normal_gt_mat_reads_as_a_unit_normal_map() {
     let Some(dir) = common::shared("diligent/pmsData/ballPNG") else { return };
-    let mat = MatFile::read(&dir.join("Normal_gt.mat")).unwrap();
+    let mat = MatFile::read(&dir.join("Normal_gt.mat"), &stdx::Limits::DEFAULT).unwrap();
     let v = mat.numeric(&["Normal_gt"]).unwrap();
     assert_eq!(v.dims, [512, 612, 3]);
     assert_eq!(v.class, MatClass::Numeric(NumericClass::Double));

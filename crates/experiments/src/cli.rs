@@ -38,6 +38,22 @@ pub fn process_compute_settings() -> Result<ComputeSettings> {
     Ok(settings)
 }
 
+/// This process's limits on users' files: [`stdx::Limits`]'s defaults, overridden by those of
+/// [`stdx::Limits::VARIABLES`] that are set in the environment (read here only, like the compute
+/// settings), for the importers of captures and DiLiGenT data.
+///
+/// # Errors
+/// A variable whose value its limit does not take, named.
+pub fn process_limits() -> Result<stdx::Limits> {
+    let mut limits = stdx::Limits::default();
+    for (variable, _) in stdx::Limits::VARIABLES {
+        if let Ok(value) = std::env::var(variable) {
+            limits = limits.with_override(variable, &value).map_err(anyhow::Error::msg)?;
+        }
+    }
+    Ok(limits)
+}
+
 /// A command on one run: fit, evaluate, analyse or export it.
 #[derive(Subcommand)]
 pub enum RunCommand {

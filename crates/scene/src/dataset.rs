@@ -20,6 +20,7 @@ use raycast_precompute::{
 };
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
+use stdx::Limits;
 
 /// An opened, verified scene.
 pub struct SceneDataset {
@@ -141,6 +142,14 @@ impl SceneDataset {
         out
     }
 
+    /// What the scene's image readers accept: no image larger than the (checksummed)
+    /// manifest's own size, so that a header that disagrees with it is refused before the
+    /// reader allocates.
+    fn image_limits(&self) -> Limits {
+        let s = &self.manifest.config.settings;
+        Limits { max_image_pixels: u64::from(s.width) * u64::from(s.height), ..Limits::DEFAULT }
+    }
+
     /// The observed image of (view, light), row-major.
     pub fn observed_image(&self, view: usize, light: usize) -> Result<Vec<[f32; 3]>> {
         self.read_exr("images", view, light)
@@ -148,7 +157,7 @@ impl SceneDataset {
 
     fn read_exr(&self, dir: &str, view: usize, light: usize) -> Result<Vec<[f32; 3]>> {
         let path = self.dir.join(format!("{dir}/{}.exr", sample_stem(view, light)));
-        let (w, h, px) = images::read_exr_rgb(&path)?;
+        let (w, h, px) = images::read_exr_rgb(&path, &self.image_limits())?;
         let s = &self.manifest.config.settings;
         if (w, h) != (s.width as usize, s.height as usize) {
             return Err(Error::Dataset {
@@ -177,7 +186,7 @@ impl SceneDataset {
     /// The flags image of (view, light).
     pub fn flags_image(&self, view: usize, light: usize) -> Result<Vec<u8>> {
         let path = self.dir.join(format!("flags/{}.png", sample_stem(view, light)));
-        let (_, _, px) = images::read_png_gray(&path)?;
+        let (_, _, px) = images::read_png_gray(&path, &self.image_limits())?;
         Ok(px)
     }
 

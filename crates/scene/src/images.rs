@@ -9,6 +9,7 @@
 use crate::error::{Error, Result};
 use exr::prelude::*;
 use std::path::Path;
+use stdx::Limits;
 
 /// Writes encoded bytes to `path` and hands them back (the generator hashes them without
 /// reading the file again).
@@ -69,28 +70,17 @@ pub fn exr_rgb_bytes(
     Ok(buf.into_inner())
 }
 
-/// Largest EXR layer the reader accepts, in pixels (8192 x 8192, about 800 MB as f32 RGB): the
-/// size comes from the file's header, and a corrupted header must be an error, not an
-/// allocation of its claim.
-pub const MAX_EXR_PIXELS: usize = 8192 * 8192;
-
 /// Reads an RGB EXR file: (width, height, row-major pixels). Non-finite values are an error,
-/// and so is a layer larger than [`MAX_EXR_PIXELS`] (checked from the header before any pixel
-/// buffer is allocated).
-pub fn read_exr_rgb(path: &Path) -> Result<(usize, usize, Vec<[f32; 3]>)> {
+/// and so is a layer larger than `limits` admit (checked from the header before any pixel
+/// buffer is allocated: the size comes from the file, and a corrupted header must be an error,
+/// not an allocation of its claim).
+pub fn read_exr_rgb(path: &Path, limits: &Limits) -> Result<(usize, usize, Vec<[f32; 3]>)> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(&bytes), false)
         .map_err(|e| image_err(path, e))?;
     for h in &meta.headers {
-        let (w, hgt) = (h.layer_size.0, h.layer_size.1);
-        if w.checked_mul(hgt).is_none_or(|n| n > MAX_EXR_PIXELS) {
-            return Err(image_err(
-                path,
-                format!(
-                    "the header declares {w} x {hgt} pixels; at most {MAX_EXR_PIXELS} are read"
-                ),
-            ));
-        }
+        let (w, hgt) = (h.layer_size.0 as u64, h.layer_size.1 as u64);
+        limits.check_pixels(w, hgt).map_err(|e| image_err(path, e))?;
     }
     let image = read()
         .no_deep_data()
@@ -122,9 +112,32 @@ pub fn write_png_gray(path: &Path, width: u32, height: u32, data: &[u8]) -> Resu
     write_bytes(path, encode_png(path, data, width, height, image::ExtendedColorType::L8)?)
 }
 
-/// Reads an 8-bit grayscale PNG: (width, height, data).
-pub fn read_png_gray(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
-    let img = image::open(path).map_err(|e| image_err(path, e))?;
+/// Decodes an image file (its format guessed from its bytes) within `limits`: the header's size
+/// is checked against [`Limits::max_image_pixels`] before the decoder allocates, and the
+/// decoder's buffers are bounded by [`Limits::max_alloc`]. The error is the fault alone, for the
+/// caller's own error type to name the file.
+///
+/// # Errors
+///
+/// An unreadable file, an image beyond the limits, or a decoding fault.
+pub fn decode_within(
+    path: &Path,
+    limits: &Limits,
+) -> std::result::Result<image::DynamicImage, String> {
+    let (w, h) = image::image_dimensions(path).map_err(|e| e.to_string())?;
+    limits.check_pixels(u64::from(w), u64::from(h))?;
+    let mut reader = image::ImageReader::open(path)
+        .and_then(|r| r.with_guessed_format())
+        .map_err(|e| e.to_string())?;
+    let mut bounds = image::Limits::default();
+    bounds.max_alloc = Some(limits.max_alloc);
+    reader.limits(bounds);
+    reader.decode().map_err(|e| e.to_string())
+}
+
+/// Reads an 8-bit grayscale PNG within `limits`: (width, height, data).
+pub fn read_png_gray(path: &Path, limits: &Limits) -> Result<(u32, u32, Vec<u8>)> {
+    let img = decode_within(path, limits).map_err(|e| image_err(path, e))?;
     if !matches!(img.color(), image::ColorType::L8) {
         return Err(image_err(
             path,
@@ -170,10 +183,33 @@ mod tests {
         let y_max = at + 17 + 4 + 12;
         bytes[y_max..y_max + 4].copy_from_slice(&19_999_999i32.to_le_bytes());
         std::fs::write(&path, &bytes).unwrap();
-        let e = read_exr_rgb(&path).unwrap_err().to_string();
+        let e = read_exr_rgb(&path, &Limits::default()).unwrap_err().to_string();
         assert!(e.contains("huge.exr") && e.contains("declares 4 x 20000000"), "{e}");
         // The unmodified file still reads.
         write_exr_rgb(&path, 4, 4, &[[0.5; 3]; 16]).unwrap();
-        assert_eq!(read_exr_rgb(&path).unwrap().2.len(), 16);
+        assert_eq!(read_exr_rgb(&path, &Limits::default()).unwrap().2.len(), 16);
+    }
+
+    /// The limits are the caller's: a tighter one refuses what the defaults read, before
+    /// decoding, naming the file and the limit.
+    #[test]
+    fn readers_take_the_callers_limits() {
+        let dir = test_support::TempDir::new("image-limits");
+        let (exr, png) = (dir.0.join("a.exr"), dir.0.join("m.png"));
+        write_exr_rgb(&exr, 4, 4, &[[0.5; 3]; 16]).unwrap();
+        write_png_gray(&png, 4, 4, &[7; 16]).unwrap();
+        let tight = Limits { max_image_pixels: 15, ..Limits::default() };
+        for e in [
+            read_exr_rgb(&exr, &tight).unwrap_err().to_string(),
+            read_png_gray(&png, &tight).unwrap_err().to_string(),
+        ] {
+            assert!(e.contains("4 x 4") && e.contains("at most 15"), "{e}");
+        }
+        assert!(read_png_gray(&png, &tight).unwrap_err().to_string().contains("m.png"));
+        let enough = Limits { max_image_pixels: 16, ..tight };
+        assert_eq!(read_png_gray(&png, &enough).unwrap().2, [7; 16]);
+        // The decoder's buffers are bounded too.
+        let no_room = Limits { max_alloc: 8, ..Limits::default() };
+        assert!(read_png_gray(&png, &no_room).is_err());
     }
 }

@@ -162,10 +162,10 @@ fn corrupted_scene_files_give_errors_not_panics(scene: &std::path::Path, tmp: &s
     let targets: [(&str, Vec<u8>, &str, Reader); 4] = [
         ("scene-manifest", manifest, "manifest.json", |p| scene::Manifest::read(p).is_ok()),
         ("scene-exr", find("images", "exr"), "image.exr", |p| {
-            scene::images::read_exr_rgb(p).is_ok()
+            scene::images::read_exr_rgb(p, &stdx::Limits::DEFAULT).is_ok()
         }),
         ("scene-flags-png", find("flags", "png"), "flags.png", |p| {
-            scene::images::read_png_gray(p).is_ok()
+            scene::images::read_png_gray(p, &stdx::Limits::DEFAULT).is_ok()
         }),
         ("scene-mesh-ply", mesh, "mesh.ply", |p| scene::mesh_file::load(p).is_ok()),
     ];

@@ -2,6 +2,7 @@
 //!
 //! - [`fs`]: atomic, durable writes of a file or a whole directory (a reader never sees a
 //!   half-written one), and the removal of a killed writer's temporaries;
+//! - [`limits`]: what a loader of users' files accepts before it allocates on a declared size;
 //! - [`lock`]: exclusive folder locks (one process at a time in a run directory or a sweep);
 //! - [`rng`]: SplitMix64, the seeded generator behind every reproducible stream that is not a
 //!   `rand` one (orbit cameras, sensor noise, light splits, Lanczos start blocks, Monte Carlo);
@@ -17,8 +18,11 @@
 pub mod cache_file;
 #[cfg(feature = "fs")]
 pub mod fs;
+pub mod limits;
 #[cfg(feature = "fs")]
 pub mod lock;
 #[cfg(feature = "progress")]
 pub mod progress;
 pub mod rng;
+
+pub use limits::Limits;

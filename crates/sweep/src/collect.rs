@@ -259,7 +259,7 @@ fn ceiling_psnr(ceiling: &[RunRecord], curves: &[RunRecord]) -> Option<f64> {
 }
 
 fn load_exr(path: &Path) -> Result<metrics::Image> {
-    let (w, h, px) = scene::images::read_exr_rgb(path)?;
+    let (w, h, px) = scene::images::read_exr_rgb(path, &stdx::Limits::DEFAULT)?;
     Ok(metrics::Image::new(w, h, px.into_iter().flatten().collect())?)
 }
 
@@ -291,7 +291,10 @@ fn figures(runs: &[CollectedRun], out: &Path, summary: &mut CollectSummary) -> R
         let Some((v, l)) = parse_stem(&stem) else { continue };
         let stem_vl = scene::sample_stem(v, l);
         let Ok(gt) = load_exr(&scene.join(format!("images/{stem_vl}.exr"))) else { continue };
-        let flags = scene::images::read_png_gray(&scene.join(format!("flags/{stem_vl}.png")));
+        let flags = scene::images::read_png_gray(
+            &scene.join(format!("flags/{stem_vl}.png")),
+            &stdx::Limits::DEFAULT,
+        );
         let mask: Option<Vec<bool>> =
             flags.ok().map(|(_, _, f)| f.iter().map(|&b| b & flag::FOREGROUND != 0).collect());
         let mut renders = Vec::new();

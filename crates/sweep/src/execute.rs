@@ -185,13 +185,13 @@ fn fit_and_evaluate(run: &Path, progress: bool, on: &RunOn) -> Result<RunEnd> {
     Ok(RunEnd::Done)
 }
 
-/// Generates the profile's semi-synthetic scenes and imports its captures under `scenes_dir`
-/// (complete ones are kept).
+/// Generates the profile's semi-synthetic scenes and imports its captures (within `limits`)
+/// under `scenes_dir` (complete ones are kept).
 pub fn prepare_scenes(
     profile: &SweepProfile,
     scenes: &[SceneSpec],
-    scenes_dir: &Path,
-    data_root: &Path,
+    (scenes_dir, data_root): (&Path, &Path),
+    limits: &stdx::Limits,
     summary: &mut SweepSummary,
 ) -> Result<Vec<PathBuf>> {
     let d = &profile.data;
@@ -211,7 +211,7 @@ pub fn prepare_scenes(
                 };
                 generate_scene(&config, &out, true)?.skipped
             }
-            SceneSource::Captured(capture) => import_capture(capture, data_root, &out)?,
+            SceneSource::Captured(capture) => import_capture(capture, data_root, &out, limits)?,
         };
         if skipped {
             summary.scenes_kept += 1;
@@ -224,18 +224,31 @@ pub fn prepare_scenes(
 }
 
 /// Imports a real capture into the scene directory `out` with the importer's defaults (the
-/// paper's 30 training and 12 test lights a view); a complete scene already there is kept
-/// (returns `true`).
-fn import_capture(capture: &CaptureSource, data_root: &Path, out: &Path) -> Result<bool> {
+/// paper's 30 training and 12 test lights a view) within `limits`; a complete scene already
+/// there is kept (returns `true`).
+fn import_capture(
+    capture: &CaptureSource,
+    data_root: &Path,
+    out: &Path,
+    limits: &stdx::Limits,
+) -> Result<bool> {
     if SceneDataset::open(out).is_ok() {
         return Ok(true);
     }
     let src = capture.find(data_root)?;
     let report = if src.join("view_01").is_dir() {
-        let o = dataset_diligent::MultiViewOptions { progress: true, ..Default::default() };
+        let o = dataset_diligent::MultiViewOptions {
+            progress: true,
+            limits: *limits,
+            ..Default::default()
+        };
         dataset_diligent::import_multi_view(&src, out, &o)
     } else {
-        let o = dataset_diligent::SingleViewOptions { progress: true, ..Default::default() };
+        let o = dataset_diligent::SingleViewOptions {
+            progress: true,
+            limits: *limits,
+            ..Default::default()
+        };
         dataset_diligent::import_single_view(&src, out, &o)
     }
     .map_err(|e| Error::format(&src, format!("importing the capture: {e}")))?;
@@ -494,6 +507,8 @@ pub struct SweepSettings {
     /// The memory the LBO eigensolver's Cholesky factor may take, in bytes (`None`: three
     /// quarters of the memory available when a solve starts).
     pub lbo_memory: Option<u64>,
+    /// What the importers of the profile's captures accept from their files.
+    pub limits: stdx::Limits,
 }
 
 /// [`sweep`] with `settings`.
@@ -515,7 +530,8 @@ pub fn sweep_with(
     let (scenes_dir, runs_dir, cache) = (layout.scenes(), layout.runs(), layout.cache());
     let scenes = plan::scenes(profile);
     let specs = plan::runs(profile)?;
-    let scene_dirs = prepare_scenes(profile, &scenes, &scenes_dir, data_root, &mut summary)?;
+    let scene_dirs =
+        prepare_scenes(profile, &scenes, (&scenes_dir, data_root), &settings.limits, &mut summary)?;
     let mut timing = SweepTiming { scenes: start.elapsed().as_secs_f64(), ..Default::default() };
     eprintln!("features: LBO tables of {} scene(s)", scene_dirs.len());
     let features = Instant::now();

@@ -372,7 +372,9 @@ fn observed_png(
     if path.is_file() {
         return Ok(Some(path));
     }
-    let Ok((w, h, px)) = scene::images::read_exr_rgb(&exr) else { return Ok(None) };
+    let Ok((w, h, px)) = scene::images::read_exr_rgb(&exr, &stdx::Limits::DEFAULT) else {
+        return Ok(None);
+    };
     experiments::eval::images::write_png_srgb_atomic(&path, w as u32, h as u32, &px)?;
     summary.files.push(path.clone());
     Ok(Some(path))
