@@ -31,7 +31,9 @@ pub mod ssim;
 pub mod testimg;
 
 pub use error::{Error, Result};
-pub use flip::{FlipConfig, FlipResult, hdr_flip, hdr_flip_with};
+pub use flip::{
+    FlipConfig, FlipExposures, FlipImage, FlipResult, hdr_flip, hdr_flip_prepared, hdr_flip_with,
+};
 pub use image::{Image, check_pair};
 pub use psnr::{psnr, psnr_linear};
 pub use ssim::{SsimConfig, dssim, dssim_linear, ssim, ssim_with};

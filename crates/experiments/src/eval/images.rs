@@ -107,21 +107,15 @@ fn to_image(w: usize, h: usize, v: &[[f32; 3]]) -> Result<Image> {
     Ok(Image::new(w, h, v.iter().flat_map(|c| c.iter().copied()).collect())?)
 }
 
-/// Scores `test` against `reference` on `mask`; returns the metrics and the HDR-FLIP result.
-/// `exposures` fixes FLIP's (start, stop) exposures; `None` derives them from the reference.
+/// Scores `test` against `reference` on `mask`; `flip` is HDR-FLIP of the same pair on the
+/// same mask (computed by the caller from prepared images, [`metrics::FlipImage`]).
 pub fn score(
     test: &Image,
     reference: &Image,
     mask: &[bool],
     lpips: Option<&Lpips>,
-    exposures: Option<(f64, f64)>,
-) -> Result<(ImageMetrics, metrics::flip::FlipResult)> {
-    let config = metrics::flip::FlipConfig {
-        start_exposure: exposures.map(|e| e.0),
-        stop_exposure: exposures.map(|e| e.1),
-        ..Default::default()
-    };
-    let flip = metrics::hdr_flip_with(test, reference, Some(mask), &config)?;
+    flip: &metrics::FlipResult,
+) -> Result<ImageMetrics> {
     let lpips = match lpips {
         Some(net) => {
             let masked = |im: &Image| {
@@ -138,13 +132,12 @@ pub fn score(
         }
         None => None,
     };
-    let m = ImageMetrics {
+    Ok(ImageMetrics {
         psnr: metrics::psnr_linear(test, reference, Some(mask))?,
         dssim: metrics::dssim_linear(test, reference, Some(mask))?,
         flip: flip.mean,
         lpips,
-    };
-    Ok((m, flip))
+    })
 }
 
 /// The paper's protocol on one test image: `test` against `reference` over the whole frame,
@@ -261,32 +254,36 @@ fn score_pair(
     let mask = t.mask(vi);
     let test = to_image(w, h, &img)?;
     let observed = to_image(w, h, &dataset.observed_image(vi, li)?)?;
-    let (model, flip) = score(&test, &observed, &mask, opts.lpips, None)?;
     // Every comparison of a test image shares the observed image's FLIP exposures (a
-    // noise-free image can be black where every lit pixel faces away).
-    let exposures = Some((flip.start_exposure, flip.stop_exposure));
+    // noise-free image can be black where every lit pixel faces away), so each of the (up to
+    // four) images is prepared for FLIP once, whichever side of a comparison it is on.
+    let range = metrics::flip::exposure_range(&observed, Some(&mask))?;
+    let at = metrics::FlipExposures::new(range, metrics::flip::DEFAULT_PPD)?;
+    let (flip_test, flip_observed) =
+        (metrics::FlipImage::new(&test, &at)?, metrics::FlipImage::new(&observed, &at)?);
+    let flip = metrics::hdr_flip_prepared(&flip_test, &flip_observed, Some(&mask))?;
+    let model = score(&test, &observed, &mask, opts.lpips, &flip)?;
     let mut scores =
         PairScores { model, clean: None, ceiling: None, paper: None, paper_observed: None };
     // The observation with its background set to 0, scored over the whole frame: the
     // paper's protocol for a capture, its other reading for a generated scene. The masked
     // LPIPS blacks out both backgrounds: it is the whole frame's here.
     let reference = background_removed(&observed, &mask)?;
-    let config = metrics::flip::FlipConfig {
-        start_exposure: exposures.map(|e| e.0),
-        stop_exposure: exposures.map(|e| e.1),
-        ..Default::default()
-    };
-    let f = metrics::hdr_flip_with(&test, &reference, None, &config)?;
+    let flip_reference = metrics::FlipImage::new(&reference, &at)?;
+    let f = metrics::hdr_flip_prepared(&flip_test, &flip_reference, None)?;
     let against_observed = whole_frame(&test, &reference, &f, scores.model.lpips)?;
     if let Some(noise_free) = dataset.clean_image(vi, li)? {
         let noise_free = to_image(w, h, &noise_free)?;
-        let (clean, clean_flip) = score(&test, &noise_free, &mask, opts.lpips, exposures)?;
+        let flip_clean = metrics::FlipImage::new(&noise_free, &at)?;
+        let clean_flip = metrics::hdr_flip_prepared(&flip_test, &flip_clean, Some(&mask))?;
+        let clean = score(&test, &noise_free, &mask, opts.lpips, &clean_flip)?;
         // Both images are 0 outside the mask: the masked LPIPS is the whole frame's.
         scores.paper = Some(whole_frame(&test, &noise_free, &clean_flip, clean.lpips)?);
         scores.paper_observed = Some(against_observed);
         scores.clean = Some(clean);
         if !opts.skip_ceiling {
-            scores.ceiling = Some(score(&noise_free, &observed, &mask, opts.lpips, exposures)?.0);
+            let f = metrics::hdr_flip_prepared(&flip_clean, &flip_observed, Some(&mask))?;
+            scores.ceiling = Some(score(&noise_free, &observed, &mask, opts.lpips, &f)?);
         }
     } else {
         scores.paper = Some(against_observed);

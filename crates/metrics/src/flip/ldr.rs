@@ -58,20 +58,20 @@ impl LdrFlip {
         (e, p)
     }
 
-    /// The per-pixel LDR-FLIP error map of `test` against `reference` (planar YCxCz).
-    pub(crate) fn error_map(
-        &self,
-        test: &[Vec<f32>; 3],
-        reference: &[Vec<f32>; 3],
-        w: usize,
-        h: usize,
-    ) -> Vec<f32> {
-        let lab_r = self.color_pre(reference, w, h);
-        let lab_t = self.color_pre(test, w, h);
-        let (er, pr) = self.features(&reference[0], w, h);
-        let (et, pt) = self.features(&test[0], w, h);
+    /// What LDR-FLIP needs of one image (planar YCxCz), whichever side of a comparison it is
+    /// on: its CSF-filtered Hunt Lab pixels and its edge and point magnitudes.
+    pub(crate) fn prepare(&self, ycxcz: &[Vec<f32>; 3], w: usize, h: usize) -> Prepared {
+        let lab = self.color_pre(ycxcz, w, h);
+        let (edge, point) = self.features(&ycxcz[0], w, h);
+        Prepared { lab, edge, point }
+    }
+
+    /// The per-pixel LDR-FLIP error map of `test` against `reference`, both prepared.
+    pub(crate) fn error_map(&self, test: &Prepared, reference: &Prepared) -> Vec<f32> {
+        let (lab_r, lab_t) = (&reference.lab, &test.lab);
+        let (er, pr, et, pt) = (&reference.edge, &reference.point, &test.edge, &test.point);
         let pccmax = PC * self.cmax;
-        (0..w * h)
+        (0..lab_r.len())
             .map(|i| {
                 let dc = super::color::hyab(lab_r[i], lab_t[i]).powf(QC);
                 let dc = if dc < pccmax {
@@ -85,4 +85,12 @@ impl LdrFlip {
             })
             .collect()
     }
+}
+
+/// One image's LDR-FLIP inputs at one exposure (see [`LdrFlip::prepare`]).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Prepared {
+    lab: Vec<[f32; 3]>,
+    edge: Vec<f32>,
+    point: Vec<f32>,
 }

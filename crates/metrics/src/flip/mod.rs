@@ -125,43 +125,129 @@ pub fn hdr_flip_with(
     cfg: &FlipConfig,
 ) -> Result<FlipResult> {
     check_pair(test, reference, mask)?;
-    if !(cfg.pixels_per_degree > 0.0 && cfg.pixels_per_degree.is_finite()) {
-        return Err(Error::Config(format!(
-            "HDR-FLIP: pixels per degree {}",
-            cfg.pixels_per_degree
-        )));
-    }
-    let (start, stop) = match (cfg.start_exposure, cfg.stop_exposure) {
+    let exposures = match (cfg.start_exposure, cfg.stop_exposure) {
         (Some(a), Some(b)) => (a, b),
         (a, b) => {
             let (s, t) = exposure_range(reference, mask)?;
             (a.unwrap_or(s), b.unwrap_or(t))
         }
     };
-    if !(start.is_finite() && stop.is_finite()) {
-        return Err(Error::Exposure(format!("exposure range [{start}, {stop}] is not finite")));
-    }
-    let exposures = ((stop - start).ceil()).max(2.0) as usize;
-    let step = (stop - start) / (exposures - 1) as f64;
-    let (w, h) = (test.width(), test.height());
-    let ldr = ldr::LdrFlip::new(cfg.pixels_per_degree);
-    let to_planes = |img: &Image, scale: f32| -> [Vec<f32>; 3] {
-        let mut planes = [vec![0.0; w * h], vec![0.0; w * h], vec![0.0; w * h]];
-        for (p, px) in img.data().chunks_exact(3).enumerate() {
-            let rgb = [px[0], px[1], px[2]].map(|v| aces(scale * v.clamp(0.0, 65536.0)));
-            let y = color::linrgb_to_ycxcz(rgb);
-            for c in 0..3 {
-                planes[c][p] = y[c];
-            }
+    let at = FlipExposures::new(exposures, cfg.pixels_per_degree)?;
+    hdr_flip_prepared(&FlipImage::new(test, &at)?, &FlipImage::new(reference, &at)?, mask)
+}
+
+/// The exposures and viewing condition of an HDR-FLIP comparison: what two [`FlipImage`]s must
+/// share to be compared.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlipExposures {
+    start: f64,
+    stop: f64,
+    pixels_per_degree: f64,
+}
+
+impl FlipExposures {
+    /// The exposure range `(start, stop)` (log2) seen at `pixels_per_degree`.
+    ///
+    /// # Errors
+    /// A range or a pixels-per-degree value that is not finite (or not positive).
+    pub fn new((start, stop): (f64, f64), pixels_per_degree: f64) -> Result<Self> {
+        if !(pixels_per_degree > 0.0 && pixels_per_degree.is_finite()) {
+            return Err(Error::Config(format!("HDR-FLIP: pixels per degree {pixels_per_degree}")));
         }
-        planes
-    };
-    let maps: Vec<Vec<f32>> = (0..exposures)
-        .into_par_iter()
-        .map(|i| {
-            let scale = (start + i as f64 * step).exp2() as f32;
-            ldr.error_map(&to_planes(test, scale), &to_planes(reference, scale), w, h)
-        })
+        if !(start.is_finite() && stop.is_finite()) {
+            return Err(Error::Exposure(format!("exposure range [{start}, {stop}] is not finite")));
+        }
+        Ok(FlipExposures { start, stop, pixels_per_degree })
+    }
+
+    /// The exposures' count, N = max(2, ceil(stop - start)).
+    pub fn count(&self) -> usize {
+        ((self.stop - self.start).ceil()).max(2.0) as usize
+    }
+
+    /// The scale 2^e_i of exposure `i`.
+    fn scale(&self, i: usize) -> f32 {
+        let step = (self.stop - self.start) / (self.count() - 1) as f64;
+        (self.start + i as f64 * step).exp2() as f32
+    }
+}
+
+/// One image prepared for HDR-FLIP at given exposures: per exposure, its tone-mapped,
+/// CSF-filtered colours and its edge and point features. Comparing two prepared images costs
+/// only the per-pixel differences, so an image compared several times at the same exposures
+/// (an evaluation scores one render against the observation, its background-free copy and the
+/// noise-free render, and the noise-free render against the observation) is filtered once; the
+/// result is bit for bit that of [`hdr_flip_with`] with the same exposures.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FlipImage {
+    width: usize,
+    height: usize,
+    at: FlipExposures,
+    per_exposure: Vec<ldr::Prepared>,
+}
+
+impl FlipImage {
+    /// `image` prepared at the exposures `at`.
+    ///
+    /// # Errors
+    /// An image with a NaN pixel.
+    pub fn new(image: &Image, at: &FlipExposures) -> Result<FlipImage> {
+        image.check_no_nan("HDR-FLIP image")?;
+        let (w, h) = (image.width(), image.height());
+        let ldr = ldr::LdrFlip::new(at.pixels_per_degree);
+        let to_planes = |scale: f32| -> [Vec<f32>; 3] {
+            let mut planes = [vec![0.0; w * h], vec![0.0; w * h], vec![0.0; w * h]];
+            for (p, px) in image.data().chunks_exact(3).enumerate() {
+                let rgb = [px[0], px[1], px[2]].map(|v| aces(scale * v.clamp(0.0, 65536.0)));
+                let y = color::linrgb_to_ycxcz(rgb);
+                for c in 0..3 {
+                    planes[c][p] = y[c];
+                }
+            }
+            planes
+        };
+        let per_exposure = (0..at.count())
+            .into_par_iter()
+            .map(|i| ldr.prepare(&to_planes(at.scale(i)), w, h))
+            .collect();
+        Ok(FlipImage { width: w, height: h, at: *at, per_exposure })
+    }
+}
+
+/// HDR-FLIP of the prepared `test` against the prepared `reference` (the same size and
+/// exposures); `mask` selects the pixels of the mean.
+///
+/// # Errors
+/// Images of different sizes or exposures, or a mask of another length or with no pixel.
+pub fn hdr_flip_prepared(
+    test: &FlipImage,
+    reference: &FlipImage,
+    mask: Option<&[bool]>,
+) -> Result<FlipResult> {
+    let (w, h) = (test.width, test.height);
+    if (reference.width, reference.height) != (w, h) {
+        return Err(Error::SizeMismatch {
+            test: (w, h),
+            reference: (reference.width, reference.height),
+        });
+    }
+    if test.at != reference.at {
+        return Err(Error::Config(format!(
+            "HDR-FLIP: test prepared at {:?}, reference at {:?}",
+            test.at, reference.at
+        )));
+    }
+    if let Some(m) = mask
+        && m.len() != w * h
+    {
+        return Err(Error::MaskSize { mask: m.len(), pixels: w * h });
+    }
+    let ldr = ldr::LdrFlip::new(test.at.pixels_per_degree);
+    let maps: Vec<Vec<f32>> = test
+        .per_exposure
+        .par_iter()
+        .zip(&reference.per_exposure)
+        .map(|(t, r)| ldr.error_map(t, r))
         .collect();
     let mut map = vec![0.0f32; w * h];
     for m in &maps {
@@ -176,12 +262,15 @@ pub fn hdr_flip_with(
             n += 1;
         }
     }
+    if n == 0 {
+        return Err(Error::Empty("HDR-FLIP mean"));
+    }
     Ok(FlipResult {
         mean: sum / n as f64,
         map,
-        start_exposure: start,
-        stop_exposure: stop,
-        exposures,
+        start_exposure: test.at.start,
+        stop_exposure: test.at.stop,
+        exposures: test.at.count(),
     })
 }
 

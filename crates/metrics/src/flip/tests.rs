@@ -154,3 +154,51 @@ fn black_background_without_mask_is_a_clear_error() {
     let mask: Vec<bool> = (0..256).map(|p| p % 16 >= 10).collect();
     assert_eq!(hdr_flip(&r, &r, Some(&mask)).unwrap(), 0.0);
 }
+
+/// Images prepared once and compared in every pairing give the maps and means of
+/// `hdr_flip_with` at the same exposures, bit for bit; images prepared at other exposures, or of
+/// other sizes, are refused.
+#[test]
+fn prepared_images_compare_as_the_direct_call() {
+    let (r, t) = hdr_pair(24, 17, 5, 4.0);
+    let (_, u) = hdr_pair(24, 17, 8, 4.0);
+    let mask: Vec<bool> = (0..24 * 17).map(|p| p % 3 != 0).collect();
+    let range = exposure_range(&r, Some(&mask)).unwrap();
+    let at = FlipExposures::new(range, DEFAULT_PPD).unwrap();
+    let cfg = FlipConfig {
+        start_exposure: Some(range.0),
+        stop_exposure: Some(range.1),
+        ..Default::default()
+    };
+    let prepared: Vec<FlipImage> =
+        [&r, &t, &u].iter().map(|i| FlipImage::new(i, &at).unwrap()).collect();
+    let images = [&r, &t, &u];
+    for (a, b) in [(1, 0), (2, 0), (1, 2), (0, 1)] {
+        for m in [None, Some(&mask[..])] {
+            let direct = hdr_flip_with(images[a], images[b], m, &cfg).unwrap();
+            let via = hdr_flip_prepared(&prepared[a], &prepared[b], m).unwrap();
+            assert_eq!(
+                direct.mean.to_bits(),
+                via.mean.to_bits(),
+                "{a} vs {b}, mask {}",
+                m.is_some()
+            );
+            assert!(direct.map.iter().zip(&via.map).all(|(x, y)| x.to_bits() == y.to_bits()));
+            assert_eq!(
+                (direct.exposures, direct.start_exposure),
+                (via.exposures, via.start_exposure)
+            );
+        }
+    }
+    let other = FlipExposures::new((range.0 - 1.0, range.1), DEFAULT_PPD).unwrap();
+    let elsewhere = FlipImage::new(&t, &other).unwrap();
+    assert!(matches!(hdr_flip_prepared(&elsewhere, &prepared[0], None), Err(Error::Config(_))));
+    let (small, _) = hdr_pair(8, 8, 1, 4.0);
+    let small = FlipImage::new(&small, &at).unwrap();
+    assert!(matches!(
+        hdr_flip_prepared(&small, &prepared[0], None),
+        Err(Error::SizeMismatch { .. })
+    ));
+    assert!(FlipExposures::new((f64::NEG_INFINITY, 1.0), DEFAULT_PPD).is_err());
+    assert!(FlipExposures::new(range, 0.0).is_err());
+}
