@@ -58,6 +58,15 @@ fn every_subcommand_has_help_and_the_run_commands_match_the_experiments_binary()
     }
 }
 
+/// Runs `cargo xtask ARGS` with the environment variable `var` set to `value`, checks that it
+/// failed, and returns its standard error.
+fn refused_with(args: &[&str], (var, value): (&str, &str)) -> String {
+    let out =
+        Command::new(env!("CARGO_BIN_EXE_xtask")).args(args).env(var, value).output().unwrap();
+    assert!(!out.status.success(), "{args:?} with {var}={value} succeeded");
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
 /// The environment's compute settings are read by the command line, once, before any work:
 /// a bad value fails `run-one` and `reproduce-tables` at once, naming the variable and what it
 /// takes, and writes nothing.
@@ -74,13 +83,7 @@ fn a_bad_compute_setting_in_the_environment_is_refused_by_name() {
             vec!["reproduce-tables", "--profile", "smoke", "--out", out_dir.to_str().unwrap()],
             vec!["run-one", out_dir.to_str().unwrap()],
         ] {
-            let out = Command::new(env!("CARGO_BIN_EXE_xtask"))
-                .args(&args)
-                .env(var, value)
-                .output()
-                .unwrap();
-            let text = String::from_utf8_lossy(&out.stderr);
-            assert!(!out.status.success(), "{args:?} with {var}={value} succeeded");
+            let text = refused_with(&args, (var, value));
             assert!(text.contains(var) && text.contains(expected), "{args:?}: {text}");
         }
         let written: Vec<_> = std::fs::read_dir(&out_dir)
@@ -106,13 +109,7 @@ fn a_bad_limit_in_the_environment_is_refused_by_name() {
             vec!["import-capture", m, "--out", o],
             vec!["import-diligent", m, "--out", o],
         ] {
-            let out = Command::new(env!("CARGO_BIN_EXE_xtask"))
-                .args(&args)
-                .env(var, value)
-                .output()
-                .unwrap();
-            let text = String::from_utf8_lossy(&out.stderr);
-            assert!(!out.status.success(), "{args:?} with {var}={value} succeeded");
+            let text = refused_with(&args, (var, value));
             let named = text.contains(var) && text.contains("positive whole number");
             assert!(named, "{args:?}: {text}");
         }
