@@ -102,6 +102,32 @@ impl Products {
         Ok(())
     }
 
+    /// Why these products would be slower than f32 on this CPU (bf16 emulated, or the AMX
+    /// kernel off), for a warning; `None` when they are not, or on a GPU backend.
+    pub fn slow_bf16_warning(&self, backend: Backend) -> Option<&'static str> {
+        if self.precision != MatmulPrecision::Bf16 || backend.is_gpu() {
+            return None;
+        }
+        if !MatmulPrecision::bf16_native() {
+            Some(
+                "matmul_precision = \"bf16\" on a CPU without AVX512-BF16: the products are \
+                 emulated, about 2x slower a step than f32 (measured on an Intel Xeon without \
+                 it); f32 is the faster choice here",
+            )
+        } else if MatmulPrecision::cpu_has_amx_bf16()
+            && !(self.bf16_amx && MatmulPrecision::bf16_on_amx())
+        {
+            Some(
+                "matmul_precision = \"bf16\" on an Intel CPU with AMX, but the AMX kernel is off \
+                 (CPU_KERNELS_AMX=0, or Linux refused the tile registers): the products run on \
+                 AVX512-BF16, measured 1.3x slower a step than f32 on such a Xeon \
+                 (benches/README.md); f32 is likely the faster choice here",
+            )
+        } else {
+            None
+        }
+    }
+
     /// The products of an inference pass of `rows` samples: f32, split as a training step on
     /// a GPU would split them (`gpu`), unsplit on the CPU.
     pub fn inference(gpu: bool, rows: usize) -> Products {

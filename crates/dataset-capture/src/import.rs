@@ -82,11 +82,7 @@ pub fn import_capture(
 
     let (ray_views, infos) = ray_views(&views, &frames, &lights, size, centre)?;
     let settings = scene_settings(&config, &views, &ray_views, size, (centre, radius));
-    let object = dir
-        .canonicalize()
-        .ok()
-        .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
-        .unwrap_or_else(|| "capture".into());
+    let object = object_name(dir);
     let scene_config = SceneConfig {
         mesh: config.mesh.clone(),
         material: MaterialSpec::Captured { benchmark: "capture".into(), object: object.clone() },
@@ -106,17 +102,8 @@ pub fn import_capture(
     };
     let min_iou = config.check.min_iou;
     let pair = |vi: usize, li: usize, g: &ViewPrecompute| -> Result<PairImages> {
-        if let Some((view, c)) = checks.lock().unwrap().iter().enumerate().find_map(|(i, c)| {
-            c.as_ref().filter(|c| c.iou.is_some_and(|x| x < min_iou)).map(|c| (i, c.clone()))
-        }) {
-            return Err(Error::Misaligned {
-                path: frames[views[view].frames[0]].image.clone(),
-                view,
-                iou: c.iou.unwrap_or(0.0),
-                min_iou,
-                mask_pixels: c.mask_pixels,
-                mesh_pixels: c.mesh_pixels,
-            });
+        if let Some(misaligned) = misaligned(&checks.lock().unwrap(), &views, &frames, min_iou) {
+            return Err(misaligned);
         }
         let v = &views[vi];
         let f = &frames[v.frames[li]];
@@ -142,6 +129,35 @@ pub fn import_capture(
     let views =
         checks.into_inner().unwrap().into_iter().map(|c| c.expect("every view traced")).collect();
     Ok(ImportReport { manifest: written.manifest, views })
+}
+
+/// The capture's object name: its folder's (`capture` where it has none).
+fn object_name(dir: &Path) -> String {
+    dir.canonicalize()
+        .ok()
+        .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .unwrap_or_else(|| "capture".into())
+}
+
+/// The error for the first traced view whose mask agrees with the mesh's silhouette less
+/// than `min_iou`, if any.
+fn misaligned(
+    checks: &[Option<ViewCheck>],
+    views: &[CaptureView],
+    frames: &[Frame],
+    min_iou: f64,
+) -> Option<Error> {
+    let (view, c) = checks.iter().enumerate().find_map(|(i, c)| {
+        c.as_ref().filter(|c| c.iou.is_some_and(|x| x < min_iou)).map(|c| (i, c))
+    })?;
+    Some(Error::Misaligned {
+        path: frames[views[view].frames[0]].image.clone(),
+        view,
+        iou: c.iou.unwrap_or(0.0),
+        min_iou,
+        mask_pixels: c.mask_pixels,
+        mesh_pixels: c.mesh_pixels,
+    })
 }
 
 /// The capture's one image size (every image must have it).

@@ -5,7 +5,8 @@
 //!
 //! A checkpoint is written into a temporary folder and renamed into place; older checkpoints
 //! are removed only after the new one is complete, so a crash or a non-finite loss always
-//! leaves the last good one.
+//! leaves the last good one. Their folders are named, listed and removed by run-format
+//! ([`run_format::held_run`]); `state.json` is written last and marks one complete.
 
 use crate::{Error, Result};
 use brdf_neural::BrdfModel;
@@ -17,7 +18,7 @@ use std::path::{Path, PathBuf};
 
 const MODEL: &str = "model.bpk";
 const OPTIM: &str = "optim.bpk";
-const STATE: &str = "state.json";
+const STATE: &str = run_format::run_dir::CHECKPOINT_STATE;
 
 /// What a checkpoint holds besides the tensors.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -61,36 +62,8 @@ pub fn save(
         let json = serde_json::to_string(state).map_err(|e| Error::format(tmp, e.to_string()))?;
         std::fs::write(tmp.join(STATE), json).map_err(|e| Error::io(tmp.join(STATE), e))
     })?;
-    remove_all_but(run, state.step)?;
+    run.remove_checkpoints_but(state.step)?;
     Ok(dir)
-}
-
-/// Removes every checkpoint folder of `run` but that of step `keep`, complete or not. Each is
-/// first renamed to a temporary name (one atomic step) and then deleted, so a kill midway
-/// leaves whole checkpoints or temporaries (which the next [`stdx::lock::DirLock`] removes),
-/// never a half-deleted folder. A run resumed after a kill between a checkpoint's write and
-/// this removal calls it again, so that it ends with the files of an uninterrupted run.
-pub fn remove_all_but(run: &RunDir, keep: u64) -> Result<()> {
-    let root = run.checkpoints();
-    let entries = match std::fs::read_dir(&root) {
-        Ok(e) => e,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
-        Err(e) => return Err(Error::io(&root, e)),
-    };
-    for entry in entries {
-        let entry = entry.map_err(|e| Error::io(&root, e))?;
-        let name = entry.file_name().to_string_lossy().into_owned();
-        let Some(step) = name.strip_prefix("step-").and_then(|s| s.parse::<u64>().ok()) else {
-            continue;
-        };
-        if step == keep {
-            continue;
-        }
-        let aside = root.join(format!(".{name}.partial-removed-{}", std::process::id()));
-        std::fs::rename(entry.path(), &aside).map_err(|e| Error::io(entry.path(), e))?;
-        std::fs::remove_dir_all(&aside).map_err(|e| Error::io(&aside, e))?;
-    }
-    Ok(())
 }
 
 /// Adam's state as a burnpack with its tensors in name order. burn lists them in the order of
@@ -110,33 +83,6 @@ fn canonical_optimizer_bytes(optim: &ModuleOptimizer) -> std::result::Result<Vec
         writer = writer.with_metadata(key, value);
     }
     Ok(writer.into_bytes().map_err(|e| format!("{e:?}"))?.to_vec())
-}
-
-/// Complete checkpoints of a run, oldest first.
-pub fn list(run: &RunDir) -> Result<Vec<(u64, PathBuf)>> {
-    let root = run.checkpoints();
-    let entries = match std::fs::read_dir(&root) {
-        Ok(e) => e,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(Error::io(&root, e)),
-    };
-    let mut out = Vec::new();
-    for entry in entries {
-        let entry = entry.map_err(|e| Error::io(&root, e))?;
-        let name = entry.file_name().to_string_lossy().into_owned();
-        if let Some(step) = name.strip_prefix("step-").and_then(|s| s.parse::<u64>().ok())
-            && entry.path().join(STATE).is_file()
-        {
-            out.push((step, entry.path()));
-        }
-    }
-    out.sort();
-    Ok(out)
-}
-
-/// The latest checkpoint, if any.
-pub fn latest(run: &RunDir) -> Result<Option<PathBuf>> {
-    Ok(list(run)?.pop().map(|(_, p)| p))
 }
 
 /// Loads a checkpoint into a freshly initialised model and optimizer of the same

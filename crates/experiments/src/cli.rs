@@ -264,9 +264,20 @@ fn fit_command(
         cfg.scene = Some(std::path::absolute(&scene).unwrap_or(scene));
     }
     let compute = process_compute_settings()?;
+    let cache_dir = cache.clone();
     let options =
-        FitOptions { progress: !quiet, cache_dir: cache, backend, compute, ..Default::default() };
-    match crate::fit(&cfg, out, options).with_context(|| format!("fit into {}", out.display()))? {
+        FitOptions { progress: !quiet, cache_dir, backend, compute, ..Default::default() };
+    let context = || format!("fit into {}", out.display());
+    cfg.validate().with_context(context)?;
+    let held = RunDir::new(out).hold("training").with_context(context)?;
+    let (outcome, trained) =
+        crate::train::fit_and_keep(Some(&cfg), &held, options).with_context(context)?;
+    // The weights for other tools, as a sweep's run exports them after its evaluation.
+    if let Some(trained) = trained {
+        let fitted = trained.into_fitted();
+        crate::portable::write_fitted(&held, &fitted).with_context(context)?;
+    }
+    match outcome {
         FitOutcome::AlreadyFinished(m) => {
             println!("{}: already finished ({} steps), skipped", out.display(), m.steps)
         }

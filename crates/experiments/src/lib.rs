@@ -1,7 +1,7 @@
 //! The stages of one run (spec sections 6 and 7): training, evaluation and export, importing
 //! one way: `export` may use `eval`; `train` and `eval` use neither other stage. What they
 //! pass on sits below them: [`data`] (records, features), [`fitted`] (a fitted run opened
-//! for analysis) and [`portable`] (the weights every fit writes for other tools).
+//! for analysis) and [`portable`] (the weights for other tools, written after evaluation).
 //! Everything the stages share about a run (its configuration, its directory, its records,
 //! the results version) lives in the crate `run_format` below; sweeps of many runs live in
 //! the crate `sweep` above.

@@ -1,5 +1,6 @@
 //! Weights others can read: a fitted model as `model.safetensors` and `model.json`, written
-//! beside `weights.bpk` when training finishes (and on demand for older runs), so that a
+//! beside `weights.bpk` by the export that follows a run's evaluation ([`write_fitted`]; the
+//! `fit` command writes them when it finishes; on demand for older runs), so that a
 //! PyTorch or numpy user can rebuild and evaluate the model without this workspace (the
 //! reference modules ship in the Python package: `neural_brdfs.reference_numpy`,
 //! `neural_brdfs.reference_torch`).
@@ -25,6 +26,7 @@
 //! `conventions` (frames and units, in words).
 
 use crate::data::vertex_features;
+use crate::fitted::FittedRun;
 use crate::{Error, Result};
 use burn::tensor::DType;
 use run_format::config::RunConfig;
@@ -43,6 +45,11 @@ struct Entry {
     dtype: &'static str,
     shape: Vec<usize>,
     bytes: Vec<u8>,
+}
+
+/// [`write`] for a fitted run into its own directory `run`, from its final weights.
+pub fn write_fitted(run: &RunDir, fitted: &FittedRun) -> Result<[PathBuf; 2]> {
+    write(run, &run.weights(), &fitted.config, &fitted.dataset, &fitted.cache)
 }
 
 /// Writes `model.safetensors` and `model.json` ([`RunDir::portable_weights`],
@@ -98,8 +105,9 @@ pub fn write(
     let (st, js) = (out.portable_weights(), out.portable_description());
     let json = serde_json::to_string_pretty(&description)
         .map_err(|e| Error::format(&js, e.to_string()))?;
+    let weights = safetensors_bytes(&tensors);
     std::fs::create_dir_all(out.path()).map_err(|e| Error::io(out.path(), e))?;
-    stdx::fs::write_atomic(&st, &safetensors_bytes(&tensors))?;
+    stdx::fs::write_atomic(&st, &weights)?;
     stdx::fs::write_atomic(&js, (json + "\n").as_bytes())?;
     Ok([st, js])
 }

@@ -23,8 +23,6 @@ use crate::train_loop::{GPU_LOSS_READS, Loop, LoopEnd, gamma_mse, save_weights};
 use crate::{Error, Result};
 use brdf_neural::device::{Backend, BackendDevice};
 use brdf_neural::fitted::{DeviceRecords, device_records, device_table};
-use brdf_neural::precision::MatmulPrecision;
-use brdf_neural::precision::PrecisionSupport;
 use brdf_neural::products::Products;
 use brdf_neural::{BrdfModel, SpatialTable};
 use burn::module::Module;
@@ -33,7 +31,8 @@ use burn::tensor::Device;
 use indicatif::ProgressBar;
 use run_format::ComputeSettings;
 use run_format::config::RunConfig;
-use run_format::run_dir::{RunDir, RunMetrics, write_curve};
+use run_format::held_run::HeldRun;
+use run_format::run_dir::{RunDir, RunMetrics};
 use run_format::train_config::OutputInit;
 use scene::SceneDataset;
 use scene::Split;
@@ -52,9 +51,6 @@ pub struct FitOptions {
     pub stop_after: Option<u64>,
     /// Called before each step.
     pub hook: Option<StepHook>,
-    /// The configuration is the one just read from the run directory's own `config.toml` (a
-    /// sweep's run): it is not read again to compare.
-    pub config_from_run_dir: bool,
     /// The burn backend that trains (`--backend`; default: the CPU backend).
     pub backend: brdf_neural::device::Backend,
     /// Whether each batch selects its inputs from tables kept on the device: its spatial rows
@@ -89,8 +85,12 @@ pub enum FitOutcome {
 }
 
 /// What a fit that trained to the end hands to evaluation in the same process, so that
-/// neither the weights nor the scene are read back from disk.
+/// neither the configuration, the weights nor the scene are read back from disk.
 pub struct Trained {
+    /// The configuration it trained.
+    pub config: RunConfig,
+    /// Its cache directory.
+    pub cache: PathBuf,
     /// The fitted model in inference mode, on `device`.
     pub model: BrdfModel,
     /// The inference device of the backend it trained on.
@@ -102,8 +102,9 @@ pub struct Trained {
 impl Trained {
     /// The run that was just trained, opened for evaluation (no weights or scene read back
     /// from disk).
-    pub fn into_fitted(self, config: RunConfig, cache: PathBuf) -> FittedRun {
-        FittedRun { config, device: self.device, model: self.model, dataset: self.scene, cache }
+    pub fn into_fitted(self) -> FittedRun {
+        let Trained { config, cache, model, device, scene } = self;
+        FittedRun { config, device, model, dataset: scene, cache }
     }
 }
 
@@ -151,100 +152,41 @@ pub fn training_data(
     Ok(RunData { scene, train, val, val_floor })
 }
 
-/// Checks a run directory against `config`: a new run writes the config; an existing one must
-/// hold the same configuration (unless `config` was just read from it). Returns the finished
-/// run's metrics, if finished.
-fn prepare_run_dir(
-    config: &RunConfig,
-    run: &RunDir,
-    from_run_dir: bool,
-) -> Result<Option<RunMetrics>> {
-    let path = run.config();
-    if from_run_dir {
-        if run.is_trained() {
-            return Ok(Some(RunMetrics::read(&run.metrics())?));
-        }
-    } else if path.is_file() {
-        let existing = RunConfig::read(&path)?;
-        if existing != *config {
-            let keys = differing_keys(&existing, config);
-            return Err(Error::format(
-                &path,
-                format!(
-                    "the run directory holds a different configuration (keys {}); use a new \
-                     run directory",
-                    keys.join(", ")
-                ),
-            ));
-        }
-        if run.is_trained() {
-            return Ok(Some(RunMetrics::read(&run.metrics())?));
-        }
-    } else {
-        stdx::fs::write_atomic(&path, config.to_toml()?.as_bytes())?;
-    }
-    Ok(None)
-}
-
-/// Dotted keys whose values differ between two configurations.
-fn differing_keys(a: &RunConfig, b: &RunConfig) -> Vec<String> {
-    fn walk(prefix: &str, a: &toml::Value, b: &toml::Value, out: &mut Vec<String>) {
-        match (a, b) {
-            (toml::Value::Table(x), toml::Value::Table(y)) => {
-                let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
-                for k in keys {
-                    let key = if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") };
-                    match (x.get(k), y.get(k)) {
-                        (Some(p), Some(q)) => walk(&key, p, q, out),
-                        _ => out.push(key),
-                    }
-                }
-            }
-            _ if a != b => out.push(prefix.to_string()),
-            _ => {}
-        }
-    }
-    let table = |c: &RunConfig| toml::Value::try_from(c).unwrap_or(toml::Value::Boolean(false));
-    let mut out = Vec::new();
-    walk("", &table(a), &table(b), &mut out);
-    out
-}
-
-/// Trains `config` into `run` (created if needed; resumed from its last checkpoint).
+/// Trains `config` into `run` (created if needed; resumed from its last checkpoint), holding
+/// the run directory's lock while it trains.
 pub fn fit(config: &RunConfig, run: &Path, options: FitOptions) -> Result<FitOutcome> {
-    fit_and_keep(config, run, options).map(|(outcome, _)| outcome)
+    config.validate()?;
+    let held = RunDir::new(run).hold("training")?;
+    fit_and_keep(Some(config), &held, options).map(|(outcome, _)| outcome)
 }
 
-/// [`fit`], also handing back the model and its scene when it trained to the end (`None` for a
-/// run that was already finished or was stopped).
+/// [`fit`] in a run directory this process holds, also handing back the model, its
+/// configuration and its scene when it trained to the end (`None` for a run that was already
+/// finished or was stopped). `config: None` trains the configuration the directory holds (a
+/// sweep's prepared run).
 pub fn fit_and_keep(
-    config: &RunConfig,
-    run: &Path,
+    config: Option<&RunConfig>,
+    held: &HeldRun,
     options: FitOptions,
 ) -> Result<(FitOutcome, Option<Trained>)> {
     let started = std::time::Instant::now();
-    config.validate()?;
-    let _lock = lock_run_dir(run)?;
-    let dir = RunDir::new(run);
-    if let Some(metrics) = prepare_run_dir(config, &dir, options.config_from_run_dir)? {
+    let (config, finished) = held.begin_training(config)?;
+    if let Some(metrics) = finished {
         return Ok((FitOutcome::AlreadyFinished(metrics), None));
     }
+    let config = &config;
+    let dir = held.dir();
     let cache = dir.cache(config, options.cache_dir.as_deref());
     let RunData { scene, train: data, val, val_floor } =
         training_data(config, (&cache, options.compute.lbo_memory_bytes()))?;
     let t = &config.train;
 
     let device = options.backend.training_device()?;
-    let (model, mut optim, state, last_checkpoint) = start(config, &dir, &data, &device)?;
+    let (model, mut optim, state, last_checkpoint) = start(config, dir, &data, &device)?;
     let resumed_from = state.step;
     if resumed_from > 0 {
-        eprintln!("{}: resuming from the checkpoint at step {resumed_from}", run.display());
+        eprintln!("{}: resuming from the checkpoint at step {resumed_from}", dir.path().display());
     }
-    let bar = progress_bar(options.progress, t.iterations, state.step);
-    let on_device = options.inputs_on_device.unwrap_or(options.backend.is_gpu());
-    let (spatial, val_spatial, records) = device_inputs(config, (&data, &val), on_device, &device)?;
-    let gpu_reads = if options.backend.is_gpu() { GPU_LOSS_READS } else { 1 };
-    let loss_reads = options.compute.loss_reads.unwrap_or(gpu_reads).max(1);
     // The training steps' products: the run's precision (checked against the backend), and on
     // a GPU the weight gradients' sum over the batch split into parts (split-K), which the
     // GPU's matrix-product kernels do not split themselves. Evaluation keeps plain f32.
@@ -252,10 +194,17 @@ pub fn fit_and_keep(
         .with_bf16_amx(options.compute.bf16_amx)
         .with_gpu(options.compute.gpu);
     products.check(options.backend)?;
-    warn_of_slow_bf16(run, products, options.backend);
+    if let Some(why) = products.slow_bf16_warning(options.backend) {
+        eprintln!("{}: warning: {why}", dir.path().display());
+    }
+    let on_device = options.inputs_on_device.unwrap_or(options.backend.is_gpu());
+    let (spatial, val_spatial, records) = device_inputs(config, (&data, &val), on_device, &device)?;
+    let gpu_reads = if options.backend.is_gpu() { GPU_LOSS_READS } else { 1 };
+    let loss_reads = options.compute.loss_reads.unwrap_or(gpu_reads).max(1);
+    let bar = progress_bar(options.progress, t.iterations, state.step);
     let lp = Loop {
         config,
-        run: &dir,
+        run: dir,
         data: &data,
         val: &val,
         device,
@@ -270,7 +219,7 @@ pub fn fit_and_keep(
     };
     let (hook, stop_after) = (options.hook, options.stop_after);
     let run_loop = || lp.run(model, &mut optim, state, last_checkpoint, hook, stop_after);
-    let end = guarded(run_loop, &lp, (&dir, options.backend))?;
+    let end = guarded(run_loop, &lp, (dir, options.backend))?;
     let (model, state) = match end {
         LoopEnd::Done(done) => *done,
         LoopEnd::Interrupted(step) => return Ok((FitOutcome::Stopped(step), None)),
@@ -285,9 +234,10 @@ pub fn fit_and_keep(
     metrics.compute = Some(options.compute.clone());
     metrics.startup_seconds = lp.startup_seconds.get();
     metrics.val_loss_floor = val_floor;
-    write_finished_run(&dir, config, (&model, &state), &metrics, (&scene, &cache))?;
+    // The weights for other tools are export's ([`crate::portable`]), written after evaluation.
+    held.write_trained(&state.curve, |path| save_weights(&model, path), &metrics)?;
     let device = lp.device.inner();
-    let trained = Trained { model: model.valid(), device, scene };
+    let trained = Trained { config: config.clone(), cache, model: model.valid(), device, scene };
     Ok((FitOutcome::Finished { metrics, resumed_from }, Some(trained)))
 }
 
@@ -304,7 +254,7 @@ fn start(
     let initial_brdf = (t.output_init == OutputInit::Data).then(|| data.mean_brdf());
     let model = BrdfModel::init_seeded(&config.model, device, config.seed, initial_brdf)?;
     let optim = AdamConfig::new().with_epsilon(t.adam_epsilon as f32).init();
-    let last_checkpoint = checkpoint::latest(dir)?;
+    let last_checkpoint = dir.latest_checkpoint()?;
     Ok(match &last_checkpoint {
         Some(c) => {
             let (model, optim, state) = checkpoint::load(c, model, optim)?;
@@ -312,25 +262,6 @@ fn start(
         }
         None => (model, optim, CheckpointState::default(), None),
     })
-}
-
-/// Locks the run directory for training: one process at a time, and taking the lock removes the
-/// temporaries of a process killed in it, and the older checkpoints a kill between a
-/// checkpoint's write and their removal left.
-fn lock_run_dir(run: &Path) -> Result<stdx::lock::DirLock> {
-    let lock = stdx::lock::DirLock::acquire(run, "training")?;
-    if lock.removed_temporaries > 0 {
-        eprintln!(
-            "{}: removed {} temporary file(s) of an interrupted write",
-            run.display(),
-            lock.removed_temporaries
-        );
-    }
-    let dir = RunDir::new(run);
-    if let Some((step, _)) = checkpoint::list(&dir)?.pop() {
-        checkpoint::remove_all_but(&dir, step)?;
-    }
-    Ok(lock)
 }
 
 /// The training and validation records' inputs kept on the device when `on_device`: the
@@ -360,50 +291,6 @@ fn device_inputs(
     Ok((spatial, val_spatial, records))
 }
 
-/// Warns when bf16 products on this CPU would be slower than f32 (emulated, or AMX off).
-fn warn_of_slow_bf16(run: &Path, products: Products, backend: Backend) {
-    if products.precision != MatmulPrecision::Bf16 || backend.is_gpu() {
-        return;
-    }
-    if !MatmulPrecision::bf16_native() {
-        eprintln!(
-            "{}: warning: matmul_precision = \"bf16\" on a CPU without AVX512-BF16: the products \
-             are emulated, about 2x slower a step than f32 (measured on an Intel Xeon \
-             without it); f32 is the faster choice here",
-            run.display()
-        );
-    } else if MatmulPrecision::cpu_has_amx_bf16()
-        && !(products.bf16_amx && MatmulPrecision::bf16_on_amx())
-    {
-        eprintln!(
-            "{}: warning: matmul_precision = \"bf16\" on an Intel CPU with AMX, but the AMX \
-             kernel is off (CPU_KERNELS_AMX=0, or Linux refused the tile registers): the products \
-             run on AVX512-BF16, measured 1.3x slower a step than f32 on such a Xeon \
-             (benches/README.md); f32 is likely the faster choice here",
-            run.display()
-        );
-    }
-}
-
-/// Writes what marks a run finished, in the order a kill anywhere between leaves resumable:
-/// the curve of the last checkpoint again (a kill between that checkpoint and its curve leaves
-/// the previous one's, and a run resumed from its last checkpoint trains no further step that
-/// would write it: the kill torture found such a run), the weights, the same weights for other
-/// tools (safetensors + JSON), and last `metrics.json`, so that a kill before it redoes them all.
-fn write_finished_run(
-    dir: &RunDir,
-    config: &RunConfig,
-    (model, state): (&BrdfModel, &CheckpointState),
-    metrics: &RunMetrics,
-    (scene, cache): (&SceneDataset, &Path),
-) -> Result<()> {
-    write_curve(&dir.curve(), &state.curve)?;
-    save_weights(model, &dir.weights())?;
-    crate::portable::write(dir, &dir.weights(), config, scene, cache)?;
-    metrics.write(&dir.metrics())?;
-    Ok(())
-}
-
 /// Runs the training loop with a panic in it turned into an error: burn and CubeCL panic when a
 /// GPU runs out of memory or is lost, and the error says so and names the checkpoint that
 /// resumes the run, as for any other failure.
@@ -421,7 +308,7 @@ fn guarded(
                 step: lp.bar.position(),
                 backend: backend.to_string(),
                 message: panic_message(payload.as_ref()),
-                checkpoint: checkpoint::latest(dir)?,
+                checkpoint: dir.latest_checkpoint()?,
             })
         }
     }

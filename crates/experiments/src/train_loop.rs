@@ -135,10 +135,7 @@ impl Loop<'_> {
                 losses.open(step, keep);
             }
             if let Some(h) = hook.as_mut() {
-                // A hook that computes parameters from parameters (a test's NaN) leaves them
-                // inside its operation's graph, which the step's backward pass consumes: the
-                // next step (inside a loss window) needs them as leaves again.
-                model = h(step, model).map(&mut FreshLeaves);
+                model = apply_hook(h, step, model);
             }
             let lr = t.lr_at(step) * state.plateau.lr_scale;
             timer.charge(Phase::Bookkeeping);
@@ -261,7 +258,7 @@ impl Loop<'_> {
         *optim = saved;
         for step in first..=bad {
             if let Some(h) = hook.as_mut() {
-                model = h(step, model).map(&mut FreshLeaves);
+                model = apply_hook(h, step, model);
             }
             let lr = self.config.train.lr_at(step) * plateau_lr_scale;
             match self.step(model, optim, (step, lr), last_checkpoint, timer, true) {
@@ -447,7 +444,7 @@ impl Loop<'_> {
                 step: state.step.saturating_sub(1),
                 loss,
                 diagnosis: diagnose(model),
-                checkpoint: checkpoint::latest(self.run)?,
+                checkpoint: self.run.latest_checkpoint()?,
             });
         }
         let dir = checkpoint::save(self.run, model, optim, state)?;
@@ -483,6 +480,13 @@ pub fn gamma_mse(records: &RecordSet, f: &[[f32; 3]]) -> f64 {
         }
     }
     sum / (3 * records.len().max(1)) as f64
+}
+
+/// The model after a step hook: a hook that computes parameters from parameters (a test's
+/// NaN) leaves them inside its operation's graph, which the step's backward pass consumes, so
+/// the next step (inside a loss window) gets them as leaves again.
+fn apply_hook(hook: &mut StepHook, step: u64, model: BrdfModel) -> BrdfModel {
+    hook(step, model).map(&mut FreshLeaves)
 }
 
 /// Writes weights atomically (a temporary sibling with the same extension, then rename).

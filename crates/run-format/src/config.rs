@@ -183,6 +183,32 @@ impl RunConfig {
         Self::from_toml(&text, path)
     }
 
+    /// Dotted keys whose values differ between this configuration and `other`.
+    pub fn differing_keys(&self, other: &RunConfig) -> Vec<String> {
+        fn walk(prefix: &str, a: &toml::Value, b: &toml::Value, out: &mut Vec<String>) {
+            match (a, b) {
+                (toml::Value::Table(x), toml::Value::Table(y)) => {
+                    let keys: std::collections::BTreeSet<&String> =
+                        x.keys().chain(y.keys()).collect();
+                    for k in keys {
+                        let key =
+                            if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") };
+                        match (x.get(k), y.get(k)) {
+                            (Some(p), Some(q)) => walk(&key, p, q, out),
+                            _ => out.push(key),
+                        }
+                    }
+                }
+                _ if a != b => out.push(prefix.to_string()),
+                _ => {}
+            }
+        }
+        let table = |c: &RunConfig| toml::Value::try_from(c).unwrap_or(toml::Value::Boolean(false));
+        let mut out = Vec::new();
+        walk("", &table(self), &table(other), &mut out);
+        out
+    }
+
     /// The resolved configuration as TOML.
     pub fn to_toml(&self) -> Result<String> {
         toml::to_string(self).map_err(|e| Error::ConfigParse {

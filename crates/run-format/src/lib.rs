@@ -12,6 +12,8 @@
 //! * [`plateau`]: the plateau rule that decays the rate and stops a converged run.
 //! * [`run_dir`]: the run directory's and the sweep directory's named paths, and
 //!   `metrics.json`'s record ([`run_dir::RunMetrics`]).
+//! * [`held_run`]: a run directory locked once for the stages that work in it, its
+//!   checkpoints' folders, and the check of its state before a fit.
 //! * [`test_metrics`]: the scores `eval` adds to it; [`metric_settings`]: their exact
 //!   settings per protocol.
 //! * [`phases`]: where a fit's and an evaluation's time goes (step timing).
@@ -25,6 +27,7 @@ pub mod compute_settings;
 pub mod config;
 mod error;
 pub mod eval_config;
+pub mod held_run;
 pub mod metric_settings;
 pub mod phases;
 pub mod plateau;
@@ -37,6 +40,7 @@ pub use compute_settings::ComputeSettings;
 pub use config::{RunConfig, TrainConfig};
 pub use error::{Error, Result};
 pub use eval_config::{EnergyEstimator, EvalConfig, EvalSettings};
+pub use held_run::HeldRun;
 pub use run_dir::{RunDir, RunMetrics};
 pub use test_metrics::{CurvePoint, EnergySummary, ImageMetrics, TestMetrics};
 

@@ -27,9 +27,13 @@
 //! a run of a sweep (one holding `run.json`), else `cache/` beside the run directory.
 
 use crate::config::RunConfig;
+use crate::held_run::HeldRun;
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+
+/// The file whose presence marks a checkpoint folder complete (written last inside it).
+pub const CHECKPOINT_STATE: &str = "state.json";
 
 /// A run directory and the paths of its files.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -137,9 +141,90 @@ impl RunDir {
         RunMetrics::read(&self.metrics()).is_ok_and(|m| m.test.is_some_and(|t| t.paper.is_some()))
     }
 
+    /// Whether the run is complete: evaluated ([`RunDir::is_evaluated`]) and its weights
+    /// exported for other tools (`model.safetensors` and `model.json`).
+    pub fn is_complete(&self) -> bool {
+        self.is_evaluated()
+            && self.portable_weights().is_file()
+            && self.portable_description().is_file()
+    }
+
     /// Reads the run's configuration.
     pub fn read_config(&self) -> Result<RunConfig> {
         RunConfig::read(&self.config())
+    }
+
+    /// Takes the lock of the run directory (created if missing) for `what` (e.g.
+    /// "training"), or fails naming the process that holds it. Taking it removes the
+    /// temporary files of a killed writer (and says how many) and the checkpoints older than
+    /// the newest one that a kill between a checkpoint's write and their removal left.
+    pub fn hold(&self, what: &str) -> Result<HeldRun> {
+        let lock = stdx::lock::DirLock::acquire(self.path(), what)?;
+        if lock.removed_temporaries > 0 {
+            eprintln!(
+                "{}: removed {} temporary file(s) of an interrupted write",
+                self.path().display(),
+                lock.removed_temporaries
+            );
+        }
+        if let Some((step, _)) = self.checkpoint_steps()?.pop() {
+            self.remove_checkpoints_but(step)?;
+        }
+        Ok(HeldRun { dir: self.clone(), _lock: lock })
+    }
+
+    /// The complete checkpoints of the run (a folder `step-NNNNNNNNN` holding
+    /// [`CHECKPOINT_STATE`]), oldest first.
+    pub fn checkpoint_steps(&self) -> Result<Vec<(u64, PathBuf)>> {
+        let mut out: Vec<(u64, PathBuf)> = self
+            .checkpoint_folders()?
+            .into_iter()
+            .filter(|(_, path)| path.join(CHECKPOINT_STATE).is_file())
+            .collect();
+        out.sort();
+        Ok(out)
+    }
+
+    /// The newest complete checkpoint, if any.
+    pub fn latest_checkpoint(&self) -> Result<Option<PathBuf>> {
+        Ok(self.checkpoint_steps()?.pop().map(|(_, p)| p))
+    }
+
+    /// Removes every checkpoint folder but that of step `keep`, complete or not. Each is first
+    /// renamed to a temporary name (one atomic step) and then deleted, so a kill midway leaves
+    /// whole checkpoints or temporaries (which the next [`RunDir::hold`] removes), never a
+    /// half-deleted folder.
+    pub fn remove_checkpoints_but(&self, keep: u64) -> Result<()> {
+        let root = self.checkpoints();
+        for (step, path) in self.checkpoint_folders()? {
+            if step == keep {
+                continue;
+            }
+            let name = path.file_name().unwrap_or_default().to_string_lossy();
+            let aside = root.join(format!(".{name}.partial-removed-{}", std::process::id()));
+            std::fs::rename(&path, &aside).map_err(|e| Error::io(&path, e))?;
+            std::fs::remove_dir_all(&aside).map_err(|e| Error::io(&aside, e))?;
+        }
+        Ok(())
+    }
+
+    /// Every folder named like a checkpoint (`step-<n>`), complete or not, in no order.
+    fn checkpoint_folders(&self) -> Result<Vec<(u64, PathBuf)>> {
+        let root = self.checkpoints();
+        let entries = match std::fs::read_dir(&root) {
+            Ok(e) => e,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+            Err(e) => return Err(Error::io(&root, e)),
+        };
+        let mut out = Vec::new();
+        for entry in entries {
+            let entry = entry.map_err(|e| Error::io(&root, e))?;
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if let Some(step) = name.strip_prefix("step-").and_then(|s| s.parse::<u64>().ok()) {
+                out.push((step, entry.path()));
+            }
+        }
+        Ok(out)
     }
 
     /// The cache of the run (see the module documentation for the order).

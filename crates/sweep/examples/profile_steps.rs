@@ -134,14 +134,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let mut short = config.clone();
             short.train.iterations = warmup;
             let start = Instant::now();
-            let (warm, _) = fit_and_keep(&short, &tmp.join(format!("{kind}-warmup")), options())?;
+            let held = RunDir::new(tmp.join(format!("{kind}-warmup"))).hold("training")?;
+            let (warm, _) = fit_and_keep(Some(&short), &held, options())?;
             let startup = match warm {
                 experiments::train::FitOutcome::Finished { metrics, .. } => metrics.startup_seconds,
                 _ => None,
             };
             warmups.push((kind.clone(), start.elapsed().as_secs_f64(), startup));
         }
-        let (outcome, trained) = fit_and_keep(&config, &run, options())?;
+        let held = RunDir::new(&run).hold("training, evaluating")?;
+        let (outcome, trained) = fit_and_keep(Some(&config), &held, options())?;
         let trained = trained.ok_or_else(|| format!("{kind}: did not train ({outcome:?})"))?;
         let metrics = run_format::RunMetrics::read(&RunDir::new(&run).metrics())?;
         let phases = metrics.phases.unwrap_or_default();
@@ -156,10 +158,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if eval_only.as_ref().is_some_and(|e| !e.contains(&kind.as_str())) {
             continue;
         }
-        let fitted = trained.into_fitted(config, layout.cache());
+        let fitted = trained.into_fitted();
         for round in 1..=eval_repeat {
             let start = Instant::now();
-            let test = eval_fitted(&fitted, &run, false, start)?;
+            let test = eval_fitted(&fitted, &held, false, start)?;
             let cells: Vec<String> =
                 test.phases.named().iter().map(|(name, s)| format!("{name} {s:.2}")).collect();
             eprintln!(

@@ -3,8 +3,8 @@
 //! runs, in this process or as `--jobs N` child processes, or written as one shell command per
 //! run for a cluster scheduler (`--emit-jobs`).
 //!
-//! A run is done when its `metrics.json` holds test metrics; [`run_one`] otherwise fits
-//! (resuming from the last checkpoint) and evaluates it. A killed sweep therefore resumes with
+//! A run is done when its `metrics.json` holds test metrics and its weights are exported;
+//! [`run_one`] otherwise fits (resuming from the last checkpoint), evaluates and exports it. A killed sweep therefore resumes with
 //! nothing lost but the steps since the last checkpoint.
 
 use super::heartbeat::{Heartbeat, ProgressLines};
@@ -20,6 +20,7 @@ use experiments::{Error, FitOptions, FitOutcome, Result};
 use indicatif::ProgressBar;
 use run_format::ComputeSettings;
 use run_format::config::SpatialKind;
+use run_format::held_run::HeldRun;
 use run_format::run_dir::{RunDir, SweepLayout};
 use scene::SceneDataset;
 use scene::{MaterialSpec, SceneConfig, SceneSettings};
@@ -118,9 +119,9 @@ pub fn exit_with_parent() {
     }
 }
 
-/// Whether a run directory holds an evaluated run.
+/// Whether a run directory holds a complete run: evaluated, its weights exported.
 pub fn is_done(run: &Path) -> bool {
-    RunDir::new(run).is_evaluated()
+    RunDir::new(run).is_complete()
 }
 
 /// How [`run_one`] ended without an error.
@@ -133,9 +134,10 @@ pub enum RunEnd {
     Interrupted(Option<u64>),
 }
 
-/// Fits (resuming) and evaluates one prepared run directory. The configuration is read once;
-/// a run trained here is evaluated with the model and scene training hands over, on the
-/// backend it trained on.
+/// Fits (resuming), evaluates and exports one prepared run directory, in that order, holding
+/// its lock throughout. The configuration is read once; a run trained here is evaluated with
+/// the model and scene training hands over, on the backend it trained on; a stage whose
+/// results the directory already holds is not run again.
 ///
 /// A failure is also recorded in the run directory ([`crate::status::Failure`], what
 /// `sweep-status` and a cluster's collect job list); the next start clears it. A run another
@@ -144,44 +146,38 @@ pub fn run_one(run: &Path, progress: bool, on: &RunOn) -> Result<RunEnd> {
     if is_done(run) {
         return Ok(RunEnd::Done);
     }
-    if let Some(holder) = stdx::lock::holder(run) {
-        return Err(Error::format(run, format!("in use by {holder}")));
-    }
+    let dir = RunDir::new(run);
+    let held = dir.hold("training, evaluating")?;
     crate::status::Failure::clear(run);
-    let end = fit_and_evaluate(run, progress, on);
+    let end = fit_evaluate_export(&held, progress, on);
     if let Err(e) = &end {
         crate::status::Failure::record(run, &e.to_string());
     }
     end
 }
 
-fn fit_and_evaluate(run: &Path, progress: bool, on: &RunOn) -> Result<RunEnd> {
+/// The stages of a held run: fit, evaluate, export.
+fn fit_evaluate_export(held: &HeldRun, progress: bool, on: &RunOn) -> Result<RunEnd> {
     let backend = on.backend;
-    let dir = RunDir::new(run);
-    let config = dir.read_config()?;
-    let cache = dir.cache(&config, None);
-    let options = FitOptions {
-        progress,
-        cache_dir: Some(cache.clone()),
-        config_from_run_dir: true,
-        backend,
-        compute: on.compute.clone(),
-        ..Default::default()
-    };
-    let fitted = match fit_and_keep(&config, run, options)? {
+    let options =
+        FitOptions { progress, backend, compute: on.compute.clone(), ..Default::default() };
+    let fitted = match fit_and_keep(None, held, options)? {
         (FitOutcome::Stopped(step), _) if experiments::interrupt::requested() => {
             return Ok(RunEnd::Interrupted(Some(step)));
         }
         (FitOutcome::Stopped(step), _) => {
-            return Err(Error::format(run, format!("training stopped at step {step}")));
+            return Err(Error::format(held.path(), format!("training stopped at step {step}")));
         }
         // The grace period after the signal is too short for an evaluation: the next start
         // evaluates the weights just written.
         _ if experiments::interrupt::requested() => return Ok(RunEnd::Interrupted(None)),
-        (_, Some(trained)) => trained.into_fitted(config, cache),
-        (_, None) => FittedRun::open_on(run, None, Some(&cache), backend)?,
+        (_, Some(trained)) => trained.into_fitted(),
+        (_, None) => FittedRun::open_on(held.path(), None, None, backend)?,
     };
-    experiments::eval::eval_fitted(&fitted, run, progress, Instant::now())?;
+    if !held.is_evaluated() {
+        experiments::eval::eval_fitted(&fitted, held, progress, Instant::now())?;
+    }
+    experiments::portable::write_fitted(held, &fitted)?;
     Ok(RunEnd::Done)
 }
 

@@ -7,7 +7,6 @@
 //! **pending** otherwise. The answer is therefore the same after the jobs have left `squeue`, on
 //! any host that sees the sweep's folder.
 
-use experiments::checkpoint;
 use run_format::run_dir::RunDir;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -106,7 +105,7 @@ impl RunState {
 /// Reads where `run` stands.
 pub fn state(run: &Path) -> RunState {
     let dir = RunDir::new(run);
-    if dir.is_evaluated() {
+    if dir.is_complete() {
         return RunState::Done;
     }
     if let Some(holder) = stdx::lock::holder(run) {
@@ -115,7 +114,7 @@ pub fn state(run: &Path) -> RunState {
     if let Some(failure) = Failure::read(run) {
         return RunState::Failed(failure);
     }
-    match checkpoint::list(&dir).ok().and_then(|mut l| l.pop()) {
+    match dir.checkpoint_steps().ok().and_then(|mut l| l.pop()) {
         Some((step, _)) => RunState::Interrupted(step),
         None => RunState::Pending,
     }

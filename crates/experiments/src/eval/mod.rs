@@ -28,6 +28,7 @@ use crate::Result;
 use crate::data::RecordSet;
 use brdf_neural::fitted::{NeuralSurface, device_table, predict, predict_on};
 use metrics::rmse::{CubeRootRmse, RmseConfig};
+use run_format::held_run::HeldRun;
 use run_format::metric_settings;
 use run_format::phases::EvalPhases;
 use run_format::run_dir::{RunDir, RunMetrics, Snapshot};
@@ -124,7 +125,7 @@ impl CeilingCache {
 /// Test PSNR and cube-root RMSE of every weight snapshot of the run.
 fn snapshot_curve(
     fitted: &FittedRun,
-    run: &Path,
+    run: &RunDir,
     snapshots: &[Snapshot],
     (samples, data): (&SampleSet, &RecordSet),
 ) -> Result<Vec<CurvePoint>> {
@@ -132,7 +133,7 @@ fn snapshot_curve(
     let gpu = !brdf_neural::device::is_cpu_device(&fitted.device);
     let table = device_table(&fitted.config.model, data.points(), gpu, &fitted.device)?;
     for s in snapshots {
-        let model = fitted.load_weights_file(&RunDir::new(run).snapshot(s.step))?;
+        let model = fitted.load_weights_file(&run.snapshot(s.step))?;
         let config = &fitted.config.model;
         let records = data.records();
         let pred = predict_on(&model, config, records, table.as_ref(), &fitted.device, false)?;
@@ -143,7 +144,8 @@ fn snapshot_curve(
     Ok(out)
 }
 
-/// Evaluates the finished run in `run`; `scene` overrides the config's scene directory.
+/// Evaluates the finished run in `run`, holding its lock; `scene` overrides the config's scene
+/// directory.
 pub fn eval(
     run: &Path,
     scene: Option<&Path>,
@@ -152,19 +154,18 @@ pub fn eval(
     progress: bool,
 ) -> Result<TestMetrics> {
     let start = Instant::now();
+    let held = RunDir::new(run).hold("evaluating")?;
     let fitted = FittedRun::open_on(run, scene, cache, backend)?;
-    eval_fitted(&fitted, run, progress, start)
+    eval_fitted(&fitted, &held, progress, start)
 }
 
-/// Evaluates an opened (or just trained) run whose directory is `run`; `start` is when the
-/// evaluation began (its wall time is recorded).
+/// Evaluates an opened (or just trained) run in the directory `run` this process holds; `start` is when the evaluation began (its wall time is recorded).
 pub fn eval_fitted(
     fitted: &FittedRun,
-    run: &Path,
+    run: &HeldRun,
     progress: bool,
     start: Instant,
 ) -> Result<TestMetrics> {
-    let _lock = stdx::lock::DirLock::acquire(run, "evaluating")?;
     let (config, device, model, dataset) =
         (&fitted.config, &fitted.device, &fitted.model, &fitted.dataset);
     let settings = config.eval.resolve(config.train.profile);
@@ -189,19 +190,21 @@ pub fn eval_fitted(
     charge(&mut phases.reciprocity);
     let energy = analyses::energy(&brdf, &data, &settings, config.seed, progress)?;
     charge(&mut phases.energy);
-    if settings.images
-        && let Some(p) = probe::probe_fitted(&brdf, dataset, &samples, &data)
-    {
-        probe::write(&RunDir::new(run).probe(), &p)?;
-    }
+    let probe =
+        if settings.images { probe::probe_fitted(&brdf, dataset, &samples, &data) } else { None };
     charge(&mut phases.probe);
-    let path = RunDir::new(run).metrics();
+    let path = run.metrics();
     let mut all = RunMetrics::read(&path)?;
     let curve = snapshot_curve(fitted, run, &all.snapshots, (&samples, &data))?;
     charge(&mut phases.curve);
     let analyses = Analyses { rmse: (rmse_cbrt, rmse_samples), reciprocity_rmse, energy, curve };
     let test = test_metrics(scores, lpips_unavailable, analyses, dataset, (start, phases));
     all.test = Some(test.clone());
+    // The probe first, `metrics.json` last: a kill between them leaves a run that evaluates
+    // again.
+    if let Some(p) = &probe {
+        probe::write(&run.probe(), p)?;
+    }
     all.write(&path)?;
     Ok(test)
 }
@@ -219,7 +222,7 @@ struct Analyses {
 /// by the one evaluation that claims it.
 fn render_and_score(
     fitted: &FittedRun,
-    run: &Path,
+    run: &RunDir,
     (samples, data): (&SampleSet, &RecordSet),
     pred: &Prediction,
     settings: &run_format::eval_config::EvalSettings,
@@ -234,7 +237,7 @@ fn render_and_score(
     let known = cached.read();
     let writer = if known.is_none() { cached.claim() } else { None };
     let opts = images::RenderOptions {
-        run,
+        run: run.path(),
         write: settings.images,
         lpips: lpips.as_ref(),
         progress,
