@@ -47,7 +47,7 @@ struct Entry {
     bytes: Vec<u8>,
 }
 
-/// [`write`] for a fitted run into its own directory `run`, from its final weights.
+/// [`write()`] for a fitted run into its own directory `run`, from its final weights.
 pub fn write_fitted(run: &RunDir, fitted: &FittedRun) -> Result<[PathBuf; 2]> {
     write(run, &run.weights(), &fitted.config, &fitted.dataset, &fitted.cache)
 }
