@@ -203,6 +203,10 @@ enum Command {
         /// The burn backend (`cpu`, `wgpu`, `cuda`).
         #[arg(long, default_value = "cpu", value_parser = parse_backend)]
         backend: Backend,
+        /// The LPIPS weight file of the run's evaluation when its `[eval]` names none
+        /// [default: $NEURAL_BRDF_LPIPS, else <data root>/lpips/alex_v0.1.lpipsw].
+        #[arg(long)]
+        lpips_weights: Option<PathBuf>,
     },
     /// Import a DiLiGenT capture (`pmsData/<obj>PNG`, the ball) or a DiLiGenT-MV object
     /// (`mvpmsData/<obj>PNG`) as a scene directory that `fit` trains on.
@@ -339,7 +343,9 @@ fn write_analytic_report(options: analytic_report::Options, out: &std::path::Pat
 }
 
 fn main() -> Result<()> {
-    match Cli::parse().command {
+    let command = Cli::parse().command;
+    let places = experiments::cli::process_places();
+    match command {
         Command::AnalyticReport { samples, pairs, seed, out } => {
             write_analytic_report(analytic_report::Options { samples, pairs, seed }, &out)?
         }
@@ -367,6 +373,7 @@ fn main() -> Result<()> {
             })?;
         }
         Command::FetchData { name, dest, only, list, allow_unverified, manifests } => {
+            let dest = dest.unwrap_or(places.data);
             fetch::run(fetch::Options { name, dest, only, list, allow_unverified, manifests })?;
         }
         Command::ReproduceTables {
@@ -385,7 +392,8 @@ fn main() -> Result<()> {
                 out,
                 jobs: jobs.unwrap_or(if backend.is_gpu() { 1 } else { 2 }),
                 emit_jobs,
-                data_root: data.unwrap_or_else(reproduce::default_data_root),
+                lpips_weights: places.clone().with_data(data.as_deref()).lpips_weights(),
+                data_root: data.unwrap_or(places.data),
                 backend,
                 matmul_precision,
                 tables,
@@ -401,7 +409,10 @@ fn main() -> Result<()> {
         Command::PublishTables { out } => {
             publish::run(&out, &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))?
         }
-        Command::RunOne { run, quiet, backend } => reproduce::run_one(&run, !quiet, backend)?,
+        Command::RunOne { run, quiet, backend, lpips_weights } => {
+            let lpips = lpips_weights.unwrap_or_else(|| places.lpips_weights());
+            reproduce::run_one(&run, !quiet, backend, lpips)?
+        }
         Command::ImportDiligent { src, out, train_lights, test_lights, target_vertices } => {
             import_diligent::run(&src, &out, train_lights, test_lights, target_vertices)?;
         }

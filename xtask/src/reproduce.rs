@@ -19,6 +19,8 @@ pub struct Options {
     pub emit_jobs: Option<PathBuf>,
     /// Data root for `data:` meshes.
     pub data_root: PathBuf,
+    /// The LPIPS weights the runs' evaluations read when their `[eval]` names none.
+    pub lpips_weights: PathBuf,
     /// The burn backend every run trains and evaluates on.
     pub backend: Backend,
     /// Precision of every run's training matrix products (`train.matmul_precision`), where
@@ -30,15 +32,20 @@ pub struct Options {
     pub slurm: Option<sweep::slurm::SlurmOptions>,
 }
 
-/// The data root: `NEURAL_BRDF_DATA`, else `./data`.
-pub fn default_data_root() -> PathBuf {
-    std::env::var_os("NEURAL_BRDF_DATA").map(PathBuf::from).unwrap_or_else(|| PathBuf::from("data"))
-}
-
-/// The command that runs one run directory in a child process: this executable's `run-one`.
-fn run_one_command(backend: Backend) -> Result<Vec<String>> {
+/// The command that runs one run directory in a child process: this executable's `run-one`,
+/// with this process's backend and LPIPS weights (an absolute path: a cluster task may start
+/// elsewhere).
+fn run_one_command(opts: &Options) -> Result<Vec<String>> {
     let exe = std::env::current_exe().context("locating the xtask executable")?;
-    Ok(vec![exe.display().to_string(), "run-one".into(), "--backend".into(), backend.to_string()])
+    let lpips = std::path::absolute(&opts.lpips_weights).unwrap_or(opts.lpips_weights.clone());
+    Ok(vec![
+        exe.display().to_string(),
+        "run-one".into(),
+        "--backend".into(),
+        opts.backend.to_string(),
+        "--lpips-weights".into(),
+        lpips.display().to_string(),
+    ])
 }
 
 /// Runs `reproduce-tables`.
@@ -142,15 +149,18 @@ fn execution(opts: &Options) -> Result<Execution> {
     );
     Ok(match (&opts.emit_jobs, opts.jobs) {
         _ if opts.slurm.is_some() => Execution::Slurm {
-            program: run_one_command(opts.backend)?.swap_remove(0),
+            program: run_one_command(opts)?.swap_remove(0),
             backend: opts.backend,
+            lpips_weights: opts.lpips_weights.clone(),
             options: opts.slurm.clone().unwrap_or_default(),
         },
-        (Some(file), _) => {
-            Execution::Emit { file: file.clone(), command: run_one_command(opts.backend)? }
-        }
-        (None, 0 | 1) => Execution::InProcess(sweep::RunOn { backend: opts.backend, compute }),
-        (None, jobs) => Execution::Children { jobs, command: run_one_command(opts.backend)? },
+        (Some(file), _) => Execution::Emit { file: file.clone(), command: run_one_command(opts)? },
+        (None, 0 | 1) => Execution::InProcess(sweep::RunOn {
+            backend: opts.backend,
+            compute,
+            lpips_weights: opts.lpips_weights.clone(),
+        }),
+        (None, jobs) => Execution::Children { jobs, command: run_one_command(opts)? },
     })
 }
 
@@ -194,10 +204,11 @@ pub fn collect(paths: &[PathBuf], out: &Path, profile: &str) -> Result<()> {
 /// Runs `run-one` (what `--jobs` children, emitted job lines and Slurm tasks execute). A
 /// SIGTERM or SIGUSR1 stops it for a requeue: a checkpoint is written and the process exits with
 /// `experiments::interrupt::EXIT_REQUEUE`.
-pub fn run_one(dir: &Path, progress: bool, backend: Backend) -> Result<()> {
+pub fn run_one(dir: &Path, progress: bool, backend: Backend, lpips_weights: PathBuf) -> Result<()> {
     sweep::exit_with_parent();
     experiments::interrupt::install();
-    let on = sweep::RunOn { backend, compute: experiments::cli::process_compute_settings()? };
+    let compute = experiments::cli::process_compute_settings()?;
+    let on = sweep::RunOn { backend, compute, lpips_weights };
     match sweep::run_one(dir, progress, &on).with_context(|| format!("run {}", dir.display()))? {
         sweep::RunEnd::Done => Ok(()),
         sweep::RunEnd::Interrupted(step) => {

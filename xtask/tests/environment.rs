@@ -16,10 +16,6 @@ const NOT_SETTINGS: &[(&str, &str, &str)] = &[
     ("crates/stdx/src/lock.rs", "HOSTNAME", "names the lock's holder"),
     ("crates/sweep/src/status.rs", "SLURM_", "the scheduler's job id, recorded with a failure"),
     ("crates/sweep/src/execute.rs", "PARENT_PID_VAR", "the parent-child protocol of --jobs"),
-    ("crates/brdf-neural/src/gpu_cache.rs", "NEURAL_BRDF_GPU_CACHE", "a cache folder (XDG)"),
-    ("crates/brdf-neural/src/gpu_cache.rs", "XDG_CACHE_HOME", "a cache folder (XDG)"),
-    ("crates/metrics/src/lpips/weights.rs", "NEURAL_BRDF_LPIPS", "the default weight file"),
-    ("crates/metrics/src/lpips/weights.rs", "NEURAL_BRDF_DATA", "the default weight file"),
     ("crates/test-support/src/", "", "test set-up (CI, the shared data)"),
 ];
 

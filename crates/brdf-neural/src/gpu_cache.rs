@@ -7,12 +7,9 @@
 //! processes), which the GPU features turn on. By default CubeCL puts that store under the
 //! `target/` folder of the outermost Cargo project around the working directory, so a run
 //! started elsewhere, or an installed binary, would tune again. Here every process of a user on
-//! a machine, every run and every `--jobs` child, uses one folder:
-//!
-//! 1. `$NEURAL_BRDF_GPU_CACHE` when set;
-//! 2. else `$XDG_CACHE_HOME/neural-brdfs/gpu`;
-//! 3. else `$HOME/.cache/neural-brdfs/gpu`;
-//! 4. else the temporary folder's `neural-brdfs-gpu`.
+//! a machine, every run and every `--jobs` child, uses one folder: the one the command line
+//! names with [`use_dir`] before the first GPU device is made (its default and variables are
+//! the command line's, `experiments::places`), else the temporary folder's `neural-brdfs-gpu`.
 //!
 //! A `cubecl.toml` (or `burn.toml`) in the working directory or above it is CubeCL's own
 //! configuration and is left alone: its `[environment]` section says where the store is then.
@@ -21,18 +18,21 @@
 //! the Vulkan compiler, so on wgpu the kernels are still compiled once per process).
 
 use std::path::PathBuf;
+use std::sync::OnceLock;
+
+/// The folder [`use_dir`] named.
+static DIR: OnceLock<PathBuf> = OnceLock::new();
+
+/// Names the folder of the GPU backends' persistent caches for this process. Only the first
+/// call counts, and only before the first GPU device is made (CubeCL reads its configuration
+/// once); it changes where autotune's measurements are kept, never a computed value.
+pub fn use_dir(dir: PathBuf) {
+    let _ = DIR.set(dir);
+}
 
 /// The folder of the GPU backends' persistent caches (see the module documentation).
 pub fn gpu_cache_dir() -> PathBuf {
-    let var = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty()).map(PathBuf::from);
-    if let Some(dir) = var("NEURAL_BRDF_GPU_CACHE") {
-        return dir;
-    }
-    let base = var("XDG_CACHE_HOME").or_else(|| var("HOME").map(|h| h.join(".cache")));
-    match base {
-        Some(base) => base.join("neural-brdfs").join("gpu"),
-        None => std::env::temp_dir().join("neural-brdfs-gpu"),
-    }
+    DIR.get().cloned().unwrap_or_else(|| std::env::temp_dir().join("neural-brdfs-gpu"))
 }
 
 /// Points CubeCL's persistent store at [`gpu_cache_dir`], before the first GPU device is
@@ -74,33 +74,11 @@ fn has_cubecl_file() -> bool {
 mod tests {
     use super::*;
 
-    /// The folder follows the documented order of variables. One test, because the
-    /// environment is the process's.
+    /// The first folder named is the one used. One test, because the folder is the process's.
     #[test]
-    fn the_cache_folder_follows_its_variables() {
-        let saved: Vec<_> = ["NEURAL_BRDF_GPU_CACHE", "XDG_CACHE_HOME", "HOME"]
-            .iter()
-            .map(|k| (*k, std::env::var_os(k)))
-            .collect();
-        // SAFETY: the only test of this crate's unit tests that reads or writes these
-        // variables; restored below.
-        unsafe {
-            std::env::set_var("NEURAL_BRDF_GPU_CACHE", "/x/gpu");
-            std::env::set_var("XDG_CACHE_HOME", "/xdg");
-            std::env::set_var("HOME", "/home/u");
-        }
+    fn the_first_folder_named_is_used() {
+        use_dir(PathBuf::from("/x/gpu"));
+        use_dir(PathBuf::from("/y/gpu"));
         assert_eq!(gpu_cache_dir(), PathBuf::from("/x/gpu"));
-        unsafe { std::env::set_var("NEURAL_BRDF_GPU_CACHE", "") };
-        assert_eq!(gpu_cache_dir(), PathBuf::from("/xdg/neural-brdfs/gpu"));
-        unsafe { std::env::remove_var("XDG_CACHE_HOME") };
-        assert_eq!(gpu_cache_dir(), PathBuf::from("/home/u/.cache/neural-brdfs/gpu"));
-        unsafe { std::env::remove_var("HOME") };
-        assert_eq!(gpu_cache_dir(), std::env::temp_dir().join("neural-brdfs-gpu"));
-        for (k, v) in saved {
-            match v {
-                Some(v) => unsafe { std::env::set_var(k, v) },
-                None => unsafe { std::env::remove_var(k) },
-            }
-        }
     }
 }

@@ -6,7 +6,9 @@
 //! glTF 2.0, Mitsuba 3 and pbrt-v4 files (a purely neural fit as a Mitsuba 3 scene for the
 //! Python package's `neural_brdf` plugin), `export-merl` any fit as a MERL binary.
 
+use crate::eval::EvalOptions;
 use crate::export::SurfacePoint;
+use crate::places::Places;
 use crate::{FitOptions, FitOutcome};
 use anyhow::{Context, Result, bail};
 use brdf_neural::device::Backend;
@@ -36,6 +38,15 @@ pub fn process_compute_settings() -> Result<ComputeSettings> {
     }
     brdf_neural::gpu_linear::launch_checked(settings.gpu.checked);
     Ok(settings)
+}
+
+/// This process's places ([`Places`]): the data root, the LPIPS weights and the GPU cache, from
+/// the environment (read here only, like the compute settings). Points the GPU backends'
+/// cache at its folder before any device is made.
+pub fn process_places() -> Places {
+    let places = Places::from_vars(|name| std::env::var_os(name));
+    brdf_neural::gpu_cache::use_dir(places.gpu_cache.clone());
+    places
 }
 
 /// This process's limits on users' files: [`stdx::Limits`]'s defaults, overridden by those of
@@ -176,13 +187,15 @@ pub fn parse_backend(name: &str) -> std::result::Result<Backend, String> {
 
 /// Runs one subcommand, printing its outcome.
 pub fn run(command: RunCommand) -> Result<()> {
+    let places = process_places();
     match command {
         RunCommand::Fit { config, scene, out, cache, backend, quiet } => {
             fit_command(config, scene, &out, cache, backend, quiet)?;
         }
         RunCommand::Eval { run, scene, cache, backend, quiet } => {
+            let options = EvalOptions { progress: !quiet, lpips_weights: places.lpips_weights() };
             let metrics =
-                crate::eval::eval(&run, scene.as_deref(), cache.as_deref(), backend, !quiet)
+                crate::eval::eval(&run, scene.as_deref(), cache.as_deref(), backend, &options)
                     .with_context(|| format!("eval of {}", run.display()))?;
             println!("{}", serde_json::to_string_pretty(&metrics)?);
         }

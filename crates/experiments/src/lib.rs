@@ -14,6 +14,7 @@
 //! * [`eval`]: test renders, maps and every metric of a finished run.
 //! * [`fitted`]: a finished (or just trained) run: configuration, model, scene.
 //! * [`export`]: a fitted model for renderers (glTF, Mitsuba 3, pbrt-v4) and as a MERL table.
+//! * [`places`]: where a process finds the data root, the LPIPS weights and the GPU cache.
 //!
 //! The binary `experiments` wraps these as `fit`, `eval` and `export` (`experiments --help`;
 //! `cargo xtask` has the same subcommands):
@@ -46,6 +47,7 @@ pub mod fitted;
 pub mod interrupt;
 pub mod loss;
 mod loss_window;
+pub mod places;
 pub mod portable;
 pub mod train;
 pub mod train_loop;

@@ -62,6 +62,39 @@ fn loss_values(run: &Path) -> Vec<f32> {
     losses(run).iter().map(|l| l.split(',').nth(1).unwrap().parse().unwrap()).collect()
 }
 
+/// A small LPIPS network (AlexNet's kernel sizes, few channels) with deterministic weights.
+fn small_lpips_weights(path: &Path) {
+    let mut t = metrics::lpips::weights::Tensors::new();
+    let (ks, channels) = ([11, 5, 3, 3, 3], [4, 4, 3, 3, 2]);
+    let mut cin = 3;
+    for k in 0..5 {
+        let (c, n) = (channels[k], channels[k] * cin * ks[k] * ks[k]);
+        let w = (0..n).map(|i| ((i * 7 % 13) as f32 - 6.0) / (6.0 * n as f32).sqrt()).collect();
+        t.insert(format!("conv{}.weight", k + 1), (vec![c, cin, ks[k], ks[k]], w));
+        t.insert(format!("conv{}.bias", k + 1), (vec![c], vec![0.05; c]));
+        t.insert(format!("lin{k}.weight"), (vec![1, c, 1, 1], vec![0.5; c]));
+        cin = c;
+    }
+    metrics::lpips::weights::write(path, &t).unwrap();
+}
+
+/// The evaluation reads the LPIPS file its process names (`EvalOptions`, the command line's
+/// place), not a place of its own.
+fn lpips_follows_the_process_place(run: &Path, weights: &Path) {
+    small_lpips_weights(weights);
+    let options =
+        experiments::eval::EvalOptions { progress: false, lpips_weights: weights.to_path_buf() };
+    let test = experiments::eval::eval(run, None, None, Default::default(), &options).unwrap();
+    assert!(test.lpips.is_some_and(f64::is_finite), "{test:?}");
+    assert_eq!(test.lpips_unavailable, None);
+    let missing = experiments::eval::EvalOptions {
+        lpips_weights: weights.with_extension("absent"),
+        ..options
+    };
+    let test = experiments::eval::eval(run, None, None, Default::default(), &missing).unwrap();
+    assert_eq!((test.lpips, test.lpips_unavailable.as_deref()), (None, Some("weights missing")));
+}
+
 #[test]
 fn models_fit_the_scene_and_eval_scores_them() {
     let dir = TempDir::new("fit");
@@ -91,7 +124,9 @@ fn models_fit_the_scene_and_eval_scores_them() {
         // A finished run is reported and skipped.
         let again = fit(&config(kind, 300, eval), &run, FitOptions::default()).unwrap();
         assert!(matches!(again, FitOutcome::AlreadyFinished(_)), "{again:?}");
-        let test = experiments::eval::eval(&run, None, None, Default::default(), false).unwrap();
+        let test =
+            experiments::eval::eval(&run, None, None, Default::default(), &Default::default())
+                .unwrap();
         assert!(test.images == 4 && test.psnr.is_finite() && test.psnr > 15.0, "{kind}: {test:?}");
         assert!(test.flip.is_finite() && test.dssim.is_finite(), "{kind}: {test:?}");
         assert!(test.rmse_cbrt.is_some_and(f64::is_finite) && test.rmse_samples > 0);
@@ -108,9 +143,12 @@ fn models_fit_the_scene_and_eval_scores_them() {
         assert!(test.clean.as_ref().is_some_and(|c| c.psnr > test.psnr), "{kind}: {test:?}");
         let ceilings = ceilings_seen.get_or_insert_with(|| ceiling.clone());
         assert_eq!(*ceilings, ceiling, "{kind}");
-        // No LPIPS weights on this machine: absent, with the reason.
+        // No LPIPS weights at the default place: absent, with the reason.
         if test.lpips.is_none() {
             assert_eq!(test.lpips_unavailable.as_deref(), Some("weights missing"));
+        }
+        if kind == "single_mlp" {
+            lpips_follows_the_process_place(&run, &dir.0.join("lpips.lpipsw"));
         }
         // The fitted BRDF of an albedo-(0.6, 0.3, 0.15) Lambertian scene conserves energy.
         let energy = test.energy.as_ref().expect("energy analysis");

@@ -7,7 +7,7 @@
 //! energy_pairs = 1000         # (x, l) pairs drawn from the test records
 //! energy_samples = 20000      # paper estimator: cosine samples per pair
 //! reciprocity_pairs = 100000  # test records used for the reciprocity RMSE (0: off)
-//! lpips_weights = "..."       # default: metrics::lpips::weights::default_path()
+//! lpips_weights = "..."       # default: the process's (<data root>/lpips/alex_v0.1.lpipsw)
 //! images = true               # write renders, FLIP maps and split figures
 //! ```
 //!
@@ -26,7 +26,7 @@ use crate::train_config::Profile;
 use crate::{Error, Result};
 use metrics::energy::Estimator;
 use serde::{Deserialize, Serialize};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Which energy estimator `eval` runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -82,8 +82,9 @@ pub struct EvalSettings {
 }
 
 impl EvalConfig {
-    /// The settings for a run of `profile`.
-    pub fn resolve(&self, profile: Profile) -> EvalSettings {
+    /// The settings for a run of `profile`, with the LPIPS weights at `default_lpips` unless
+    /// the table names them (the evaluating process's place, `experiments::places`).
+    pub fn resolve(&self, profile: Profile, default_lpips: &Path) -> EvalSettings {
         let (estimator, pairs, recip) = match profile {
             Profile::Quick => (EnergyEstimator::Fast, 1_000, 100_000),
             Profile::Cpu => (EnergyEstimator::Fast, 5_000, 100_000),
@@ -101,10 +102,7 @@ impl EvalConfig {
             energy_name,
             energy_pairs: self.energy_pairs.unwrap_or(pairs),
             reciprocity_pairs: self.reciprocity_pairs.unwrap_or(recip),
-            lpips_weights: self
-                .lpips_weights
-                .clone()
-                .unwrap_or_else(metrics::lpips::weights::default_path),
+            lpips_weights: self.lpips_weights.clone().unwrap_or_else(|| default_lpips.into()),
             images: self.images.unwrap_or(true),
         }
     }
@@ -135,18 +133,22 @@ mod tests {
 
     #[test]
     fn profiles_pick_the_estimator_and_keys_override() {
-        let q = EvalConfig::default().resolve(Profile::Quick);
+        let here = Path::new("data/lpips/alex_v0.1.lpipsw");
+        let q = EvalConfig::default().resolve(Profile::Quick, here);
         assert_eq!((q.energy_name, q.energy_pairs), ("fast", 1_000));
-        let f = EvalConfig::default().resolve(Profile::Full);
+        assert_eq!(q.lpips_weights, here);
+        let f = EvalConfig::default().resolve(Profile::Full, here);
         assert_eq!(f.energy, Some(Estimator::MonteCarlo { samples: 20_000 }));
         assert_eq!(f.energy_pairs, 50_000);
         let c = EvalConfig {
             energy_estimator: Some(EnergyEstimator::Off),
             images: Some(false),
+            lpips_weights: Some("mine.lpipsw".into()),
             ..Default::default()
         };
-        let r = c.resolve(Profile::Quick);
+        let r = c.resolve(Profile::Quick, here);
         assert!(r.energy.is_none() && !r.images);
+        assert_eq!(r.lpips_weights, Path::new("mine.lpipsw"));
         let bad = EvalConfig { energy_pairs: Some(0), ..Default::default() };
         assert!(bad.validate().unwrap_err().to_string().contains("eval.energy_pairs"));
     }

@@ -161,7 +161,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let fitted = trained.into_fitted();
         for round in 1..=eval_repeat {
             let start = Instant::now();
-            let test = eval_fitted(&fitted, &held, false, start)?;
+            let test = eval_fitted(&fitted, &held, &Default::default(), start)?;
             let cells: Vec<String> =
                 test.phases.named().iter().map(|(name, s)| format!("{name} {s:.2}")).collect();
             eprintln!(

@@ -14,6 +14,7 @@ use super::shell;
 use super::timing::SweepTiming;
 use brdf_neural::device::Backend;
 use dataset_merl::generate_scene;
+use experiments::eval::EvalOptions;
 use experiments::fitted::FittedRun;
 use experiments::train::fit_and_keep;
 use experiments::{Error, FitOptions, FitOutcome, Result};
@@ -48,6 +49,8 @@ pub enum Execution {
         program: String,
         /// The backend of the runs.
         backend: Backend,
+        /// The LPIPS weights of the runs' evaluations when their `[eval]` names none.
+        lpips_weights: PathBuf,
         /// The submission's settings.
         options: crate::slurm::SlurmOptions,
     },
@@ -60,14 +63,28 @@ pub enum Execution {
     },
 }
 
-/// What the runs a process executes train on: the burn backend, and how they compute beyond
-/// their configuration ([`ComputeSettings`], the CLI's environment overrides).
-#[derive(Clone, Debug, Default, PartialEq)]
+/// What the runs a process executes train on: the burn backend, how they compute beyond their
+/// configuration ([`ComputeSettings`], the CLI's environment overrides), and the LPIPS weight
+/// file their evaluations read (the process's place, `experiments::places`).
+#[derive(Clone, Debug, PartialEq)]
 pub struct RunOn {
     /// The backend of the runs.
     pub backend: Backend,
     /// The compute settings of the runs.
     pub compute: ComputeSettings,
+    /// The LPIPS weights of the runs' evaluations when their `[eval]` names none.
+    pub lpips_weights: PathBuf,
+}
+
+impl Default for RunOn {
+    /// The CPU backend, the default compute settings and places.
+    fn default() -> Self {
+        RunOn {
+            backend: Backend::default(),
+            compute: ComputeSettings::default(),
+            lpips_weights: experiments::places::Places::default().lpips_weights(),
+        }
+    }
 }
 
 /// What a sweep did.
@@ -175,7 +192,8 @@ fn fit_evaluate_export(held: &HeldRun, progress: bool, on: &RunOn) -> Result<Run
         (_, None) => FittedRun::open_on(held.path(), None, None, backend)?,
     };
     if !held.is_evaluated() {
-        experiments::eval::eval_fitted(&fitted, held, progress, Instant::now())?;
+        let options = EvalOptions { progress, lpips_weights: on.lpips_weights.clone() };
+        experiments::eval::eval_fitted(&fitted, held, &options, Instant::now())?;
     }
     experiments::portable::write_fitted(held, &fitted)?;
     Ok(RunEnd::Done)
@@ -536,11 +554,16 @@ pub fn sweep_with(
     summary.runs = prepare_runs(&specs, &scenes, &scene_dirs, &runs_dir)?;
     let runs = Instant::now();
     execute(&summary.runs.clone(), how, &settings.progress, &mut summary)?;
-    if let Execution::Slurm { program, backend, options } = how {
+    if let Execution::Slurm { program, backend, lpips_weights, options } = how {
         let todo: Vec<PathBuf> = summary.runs.iter().filter(|d| !is_done(d)).cloned().collect();
         // Nothing left to run: no job is submitted, and the tables are made here.
         if !todo.is_empty() {
-            let first = (profile.name.as_str(), program.as_str(), backend.name());
+            let first = crate::slurm::FirstSubmission {
+                profile: &profile.name,
+                program,
+                backend: backend.name(),
+                lpips_weights,
+            };
             summary.submission =
                 Some(crate::slurm::submit(out, &summary.runs, &todo, Some(first), options)?);
         }

@@ -24,8 +24,8 @@ use std::time::Instant;
 pub struct Options {
     /// Manifest name (`None` only with `list`).
     pub name: Option<String>,
-    /// Data root (`--dest`, else `$NEURAL_BRDF_DATA`, else `./data`).
-    pub dest: Option<PathBuf>,
+    /// Data root (`--dest`, else the process's, `experiments::places`).
+    pub dest: PathBuf,
     /// Entry names to fetch (all when empty).
     pub only: Vec<String>,
     /// Print the manifests and their entries instead of fetching.
@@ -56,7 +56,7 @@ pub fn run(opts: Options) -> Result<()> {
         bail!("name a manifest (see `cargo xtask fetch-data --list`)");
     };
     let m = manifest::find(&dir, name)?;
-    let root = data_root(opts.dest.clone());
+    let root = opts.dest.clone();
     let entries = select(&m, &opts.only)?;
     std::fs::create_dir_all(&root).with_context(|| format!("creating {}", root.display()))?;
     let mut lock = Lock::load(&root)?;
@@ -94,12 +94,6 @@ pub fn run(opts: Options) -> Result<()> {
         root.display()
     );
     Ok(())
-}
-
-/// `--dest`, else `$NEURAL_BRDF_DATA`, else `./data`.
-fn data_root(dest: Option<PathBuf>) -> PathBuf {
-    dest.or_else(|| std::env::var_os("NEURAL_BRDF_DATA").map(PathBuf::from))
-        .unwrap_or_else(|| PathBuf::from("data"))
 }
 
 fn select<'a>(m: &'a Manifest, only: &[String]) -> Result<Vec<&'a Entry>> {

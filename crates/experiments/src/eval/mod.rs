@@ -26,6 +26,7 @@ pub use brdf_neural::fitted::Prediction;
 
 use crate::Result;
 use crate::data::RecordSet;
+use crate::places::Places;
 use brdf_neural::fitted::{NeuralSurface, device_table, predict, predict_on};
 use metrics::rmse::{CubeRootRmse, RmseConfig};
 use run_format::held_run::HeldRun;
@@ -34,7 +35,7 @@ use run_format::phases::EvalPhases;
 use run_format::run_dir::{RunDir, RunMetrics, Snapshot};
 use run_format::{CurvePoint, EnergyEstimator, EnergySummary, ImageMetrics, TestMetrics};
 use scene::SampleSet;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Only the energy analysis of a finished run, with `estimator` and `pairs` overriding the
@@ -53,7 +54,8 @@ pub fn energy_of_run(
         eval.energy_pairs = pairs;
     }
     eval.validate()?;
-    let settings = eval.resolve(run.config.train.profile);
+    // The energy analysis reads no LPIPS weights: no place of them is needed.
+    let settings = eval.resolve(run.config.train.profile, Path::new(""));
     let (_, data) = run.test_records()?;
     let config = &run.config;
     let brdf = NeuralSurface::new(&run.model, &config.model, data.points(), &run.device)?;
@@ -151,24 +153,43 @@ pub fn eval(
     scene: Option<&Path>,
     cache: Option<&Path>,
     backend: brdf_neural::device::Backend,
-    progress: bool,
+    options: &EvalOptions,
 ) -> Result<TestMetrics> {
     let start = Instant::now();
     let held = RunDir::new(run).hold("evaluating")?;
     let fitted = FittedRun::open_on(run, scene, cache, backend)?;
-    eval_fitted(&fitted, &held, progress, start)
+    eval_fitted(&fitted, &held, options, start)
 }
 
-/// Evaluates an opened (or just trained) run in the directory `run` this process holds; `start` is when the evaluation began (its wall time is recorded).
+/// How a process evaluates, beyond the run's configuration.
+#[derive(Clone, Debug)]
+pub struct EvalOptions {
+    /// Show progress bars.
+    pub progress: bool,
+    /// The LPIPS weight file when the run's `[eval]` names none: the process's place
+    /// ([`crate::places::Places::lpips_weights`]).
+    pub lpips_weights: PathBuf,
+}
+
+impl Default for EvalOptions {
+    /// No progress bars, the default places' LPIPS file.
+    fn default() -> Self {
+        EvalOptions { progress: false, lpips_weights: Places::default().lpips_weights() }
+    }
+}
+
+/// Evaluates an opened (or just trained) run in the directory `run` this process holds;
+/// `start` is when the evaluation began (its wall time is recorded).
 pub fn eval_fitted(
     fitted: &FittedRun,
     run: &HeldRun,
-    progress: bool,
+    options: &EvalOptions,
     start: Instant,
 ) -> Result<TestMetrics> {
     let (config, device, model, dataset) =
         (&fitted.config, &fitted.device, &fitted.model, &fitted.dataset);
-    let settings = config.eval.resolve(config.train.profile);
+    let settings = config.eval.resolve(config.train.profile, &options.lpips_weights);
+    let progress = options.progress;
     let mut phases = EvalPhases::default();
     let mut lap = Instant::now();
     let mut charge = |phase: &mut f64| {

@@ -10,8 +10,8 @@
 //! * [`ALEXNET_URL`]: torchvision's ImageNet AlexNet;
 //! * [`LIN_URL`]: the LPIPS v0.1 linear layers.
 //!
-//! **Location**: `$NEURAL_BRDF_LPIPS` if set, else `<data>/lpips/alex_v0.1.lpipsw` with `<data>`
-//! from `NEURAL_BRDF_DATA` (default `../shared/data`).
+//! **Location**: [`default_path`] of a data root, `<data>/lpips/alex_v0.1.lpipsw` (where
+//! `cargo xtask fetch-data lpips` leaves it); the command line may name another file.
 
 use crate::error::{Error, Result};
 use sha2::{Digest, Sha256};
@@ -29,13 +29,9 @@ const MAGIC: &[u8; 8] = b"LPIPSW1\0";
 /// A named tensor: shape and row-major values.
 pub type Tensors = BTreeMap<String, (Vec<usize>, Vec<f32>)>;
 
-/// The default weight file location (see the module doc).
-pub fn default_path() -> PathBuf {
-    if let Some(p) = std::env::var_os("NEURAL_BRDF_LPIPS") {
-        return PathBuf::from(p);
-    }
-    let data = std::env::var_os("NEURAL_BRDF_DATA").map_or("../shared/data".into(), PathBuf::from);
-    data.join("lpips").join("alex_v0.1.lpipsw")
+/// The weight file's place under a data root (see the module doc).
+pub fn default_path(data_root: &Path) -> PathBuf {
+    data_root.join("lpips").join("alex_v0.1.lpipsw")
 }
 
 /// Reads a weight file.

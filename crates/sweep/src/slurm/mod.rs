@@ -113,6 +113,10 @@ pub struct SlurmSweep {
     pub program: String,
     /// `--backend` of the runs.
     pub backend: String,
+    /// `--lpips-weights` of the runs (absolute; `None` in a record of an older version: the
+    /// tasks' own default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lpips_weights: Option<PathBuf>,
     /// Every run of the sweep (absolute), finished or not: the collect job's tables.
     pub runs: Vec<PathBuf>,
     /// The user's settings.
@@ -152,13 +156,26 @@ impl SlurmSweep {
     }
 }
 
+/// What a sweep's first submission records: the profile's name and what its tasks run.
+#[derive(Clone, Copy, Debug)]
+pub struct FirstSubmission<'a> {
+    /// The profile's name.
+    pub profile: &'a str,
+    /// The xtask executable the tasks run (absolute).
+    pub program: &'a str,
+    /// `--backend` of the runs.
+    pub backend: &'a str,
+    /// `--lpips-weights` of the runs (made absolute).
+    pub lpips_weights: &'a Path,
+}
+
 /// Submits `todo` (unfinished runs among `all`, the sweep's runs) as a new submission of the
-/// sweep `out`, and records it; `profile`, `program` and `backend` are recorded on the first.
+/// sweep `out`, and records it; what the tasks run is recorded on the first.
 pub fn submit(
     out: &Path,
     all: &[PathBuf],
     todo: &[PathBuf],
-    first: Option<(&str, &str, &str)>,
+    first: Option<FirstSubmission>,
     options: &SlurmOptions,
 ) -> Result<Submission> {
     let mut sweep = sweep_record(out, all, first, options)?;
@@ -177,6 +194,7 @@ pub fn submit(
         name: &name,
         program: &sweep.program,
         backend: backend.name(),
+        lpips_weights: sweep.lpips_weights.as_deref(),
         options: &sbatch_options,
         logs: &logs,
     };
@@ -235,11 +253,11 @@ pub fn submit(
 
 /// The sweep's record with this submission's runs and options: the one on disk (an unreadable
 /// one is an error, not replaced: its job ids would be lost), or a new one for a first
-/// submission (`first`: profile, program, backend).
+/// submission (`first`).
 fn sweep_record(
     out: &Path,
     all: &[PathBuf],
-    first: Option<(&str, &str, &str)>,
+    first: Option<FirstSubmission>,
     options: &SlurmOptions,
 ) -> Result<SlurmSweep> {
     let recorded = SlurmSweep::path(out).exists();
@@ -256,21 +274,25 @@ fn sweep_record(
             s
         }
         Err(_) => {
-            let (profile, program, backend) = first.ok_or_else(|| {
+            let f = first.ok_or_else(|| {
                 Error::format(SlurmSweep::path(out), "no submission recorded to resubmit")
             })?;
             SlurmSweep {
-                profile: profile.into(),
-                program: program.into(),
-                backend: backend.into(),
+                profile: f.profile.into(),
+                program: f.program.into(),
+                backend: f.backend.into(),
+                lpips_weights: None,
                 runs: absolute_all(all)?,
                 options: options.clone(),
                 submissions: Vec::new(),
             }
         }
     };
-    if let Some((_, program, backend)) = first {
-        (sweep.program, sweep.backend) = (program.into(), backend.into());
+    if let Some(f) = first {
+        (sweep.program, sweep.backend) = (f.program.into(), f.backend.into());
+        let lpips =
+            std::path::absolute(f.lpips_weights).map_err(|e| Error::io(f.lpips_weights, e))?;
+        sweep.lpips_weights = Some(lpips);
     }
     Ok(sweep)
 }

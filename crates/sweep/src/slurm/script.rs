@@ -20,6 +20,8 @@ pub struct ScriptSettings<'a> {
     pub program: &'a str,
     /// `--backend` of `run-one`.
     pub backend: &'a str,
+    /// `--lpips-weights` of `run-one` (absolute), when recorded.
+    pub lpips_weights: Option<&'a Path>,
     /// `--partition`, `--account`, `--qos` and the user's extra `#SBATCH` options, as
     /// `--key=value` words.
     pub options: &'a [String],
@@ -75,7 +77,7 @@ exec >>"$run/sweep.log" 2>&1
 echo "== task $task (job $SLURM_JOB_ID, start $((${{SLURM_RESTART_COUNT:-0}} + 1))) on $(hostname) at $(date -u +%Y-%m-%dT%H:%M:%SZ)"
 # The run's threads: the CPUs Slurm gave the task (also where no cgroup confines them).
 export RAYON_NUM_THREADS="${{SLURM_CPUS_PER_TASK:-1}}"
-{program} run-one --quiet --backend {backend} "$run" &
+{program} run-one --quiet --backend {backend}{lpips} "$run" &
 child=$!
 signalled=0
 trap 'signalled=1; kill -TERM "$child" 2>/dev/null' TERM USR1
@@ -95,6 +97,9 @@ exit "$rc"
         tasks = shell_quote(&tasks.display().to_string()),
         program = shell_quote(s.program),
         backend = shell_quote(s.backend),
+        lpips = s.lpips_weights.map_or(String::new(), |p| {
+            format!(" --lpips-weights {}", shell_quote(&p.display().to_string()))
+        }),
     ));
     out
 }
@@ -130,6 +135,7 @@ mod tests {
             name: "nbrdf-smoke",
             program: "/opt/x task/xtask",
             backend: "flex",
+            lpips_weights: Some(Path::new("/data/lpips/alex_v0.1.lpipsw")),
             options: &options,
             logs: Path::new("/sweep/slurm/logs"),
         };
@@ -150,7 +156,8 @@ mod tests {
             "#SBATCH --requeue",
             "#SBATCH --partition=cpu",
             "#SBATCH --output=/sweep/slurm/logs/%A_%a.out",
-            "'/opt/x task/xtask' run-one --quiet --backend flex \"$run\" &",
+            "'/opt/x task/xtask' run-one --quiet --backend flex --lpips-weights \
+             /data/lpips/alex_v0.1.lpipsw \"$run\" &",
             "scontrol requeue \"$task\"",
         ] {
             assert!(text.contains(line), "{line} missing from\n{text}");
