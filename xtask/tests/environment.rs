@@ -105,3 +105,26 @@ fn the_check_sees_a_read() {
     assert_eq!(r.len(), 1, "{r:?}");
     assert_eq!(r[0].0, 2);
 }
+
+/// The product finds its data through the command line's places (`experiments::places`), never
+/// in the development checkout's `../shared` (only the tests' set-up looks there).
+#[test]
+fn the_product_never_looks_in_the_shared_folder() {
+    let root = root();
+    let mut found = Vec::new();
+    for file in sources() {
+        let rel = file.strip_prefix(&root).unwrap().to_string_lossy().replace('\\', "/");
+        if rel.starts_with("crates/test-support/") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&file).unwrap();
+        let code = text.split("#[cfg(test)]").next().unwrap_or("");
+        for (i, line) in code.lines().enumerate() {
+            let line = line.split("//").next().unwrap_or("");
+            if line.contains("shared/data") || line.contains("../shared") {
+                found.push(format!("{rel}:{}: {}", i + 1, line.trim()));
+            }
+        }
+    }
+    assert!(found.is_empty(), "the product reads the shared folder:\n{}", found.join("\n"));
+}
