@@ -204,7 +204,7 @@ enum Command {
         #[arg(long, default_value = "cpu", value_parser = parse_backend)]
         backend: Backend,
         /// The LPIPS weight file of the run's evaluation when its `[eval]` names none
-        /// [default: $NEURAL_BRDF_LPIPS, else <data root>/lpips/alex_v0.1.lpipsw].
+        /// (default: `$NEURAL_BRDF_LPIPS`, else `<data root>/lpips/alex_v0.1.lpipsw`).
         #[arg(long)]
         lpips_weights: Option<PathBuf>,
     },
