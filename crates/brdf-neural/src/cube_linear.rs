@@ -19,7 +19,8 @@ use burn::backend::tensor::FloatTensor;
 use burn::tensor::{DType, Shape};
 use burn_cubecl::CubeBackend;
 use burn_cubecl::tensor::CubeTensor;
-use gpu_kernels::linear::{self as kernels, Matrix, Precision};
+use gpu_kernels::linear::{self as kernels, Matrix};
+use gpu_kernels::plan::{Precision, Tuning};
 use std::sync::Once;
 
 type B = CubeBackend;
@@ -44,7 +45,7 @@ fn kernel_precision(client: &cubecl::prelude::Client, p: MatmulPrecision) -> Pre
 }
 
 /// The kernels' tile and split length of a batch's products.
-fn tuning(products: Products) -> kernels::Tuning {
+fn tuning(products: Products) -> Tuning {
     crate::gpu_linear::kernel_tuning(products.gpu)
 }
 

@@ -30,8 +30,8 @@ pub fn launch_checked(checked: bool) {
 
 /// The kernels' spelling of `tuning`'s tile and split length.
 #[cfg(any(feature = "wgpu", feature = "cuda"))]
-pub(crate) fn kernel_tuning(tuning: GpuTuning) -> gpu_kernels::linear::Tuning {
-    use gpu_kernels::gemm::Tiling;
+pub(crate) fn kernel_tuning(tuning: GpuTuning) -> gpu_kernels::plan::Tuning {
+    use gpu_kernels::plan::Tiling;
     let tiling = match tuning.tile {
         GpuTile::T64 => Tiling::T64,
         GpuTile::T128 => Tiling::T128,
@@ -39,7 +39,7 @@ pub(crate) fn kernel_tuning(tuning: GpuTuning) -> gpu_kernels::linear::Tuning {
         GpuTile::T128V => Tiling::T128V,
     };
     // model-spec checked the length (a power of two from 64 to 65,536); the kernels check again.
-    let tuning_of = gpu_kernels::linear::Tuning { tiling, split_len: None };
+    let tuning_of = gpu_kernels::plan::Tuning { tiling, split_len: None };
     tuning_of.with_split_len(tuning.split_len).unwrap_or(tuning_of)
 }
 
@@ -49,10 +49,10 @@ mod tests {
 
     #[test]
     fn every_tile_and_split_length_reaches_the_kernels() {
-        use gpu_kernels::gemm::Tiling;
+        use gpu_kernels::plan::Tiling;
         let t =
             |tile, split_len| kernel_tuning(GpuTuning { tile, split_len, ..Default::default() });
-        assert_eq!(t(GpuTile::T64, None), gpu_kernels::linear::Tuning::default());
+        assert_eq!(t(GpuTile::T64, None), gpu_kernels::plan::Tuning::default());
         assert_eq!(t(GpuTile::T128V, Some(512)).tiling, Tiling::T128V);
         assert_eq!(t(GpuTile::T64V, Some(512)).split_len, Some(512));
         assert_eq!(t(GpuTile::T128, None).tiling, Tiling::T128);

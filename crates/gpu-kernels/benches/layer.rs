@@ -15,9 +15,9 @@
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use cubecl::prelude::*;
 use gpu_kernels::checks;
-use gpu_kernels::gemm::Tiling;
-use gpu_kernels::linear::Precision::{self, F32};
-use gpu_kernels::linear::{self, Matrix, Tuning};
+use gpu_kernels::linear::{self, Matrix};
+use gpu_kernels::plan::Precision::{self, F32};
+use gpu_kernels::plan::{Tiling, Tuning};
 use std::time::Instant;
 
 const WIDTH: u32 = 128;

@@ -21,44 +21,9 @@
 //! | `c` | splits x m x n, row-major | the product, or one partial sum per split |
 
 use crate::gemm_vec4::{gemm_vec4, gemm_vec4_128};
+use crate::plan::{Tiling, UNITS};
 use cubecl::prelude::*;
 
-/// Units per cube along each axis.
-pub const UNITS: u32 = 16;
-
-/// The tile of C one cube computes.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum Tiling {
-    /// 64 x 64, 4 x 4 sums a unit: many cubes for short or narrow products (the default).
-    #[default]
-    T64,
-    /// 128 x 128, 8 x 8 sums a unit: twice the arithmetic per shared-memory read.
-    T128,
-    /// 64 x 64, 4 x 4 sums a unit in contiguous rows and columns, the slabs read from shared
-    /// memory four floats at a time ([`crate::gemm_vec4`]).
-    T64V,
-    /// 128 x 128, 8 x 8 sums a unit in two blocks of four contiguous rows and columns, the
-    /// slabs read from shared memory four floats at a time ([`crate::gemm_vec4`]).
-    T128V,
-}
-
-impl Tiling {
-    /// Every tiling (the tests run each).
-    pub const ALL: [Tiling; 4] = [Tiling::T64, Tiling::T128, Tiling::T64V, Tiling::T128V];
-
-    /// Rows and columns of C per cube.
-    pub fn tile(self) -> u32 {
-        UNITS * self.per_unit()
-    }
-
-    /// Rows and columns of sums per unit.
-    pub fn per_unit(self) -> u32 {
-        match self {
-            Tiling::T64 | Tiling::T64V => 4,
-            Tiling::T128 | Tiling::T128V => 8,
-        }
-    }
-}
 /// The k step staged in shared memory.
 pub const K_STEP: u32 = 16;
 

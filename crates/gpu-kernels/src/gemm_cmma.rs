@@ -16,7 +16,7 @@
 //! Within a split the sums run in an order fixed by the shapes (the hardware's within each
 //! fragment product), so results are the same bits run to run on one device.
 //!
-//! [`Precision::Bf16`]: crate::linear::Precision::Bf16
+//! [`Precision::Bf16`]: crate::plan::Precision::Bf16
 
 use crate::gemm::{Epilogue, GemmShape};
 use cubecl::cmma;

@@ -17,8 +17,8 @@
 //! different banks. Each sum runs in the scalar kernel's order (k ascending within a split);
 //! whether a multiply-add is fused is the shader compiler's choice in either kernel.
 //!
-//! [`Tiling::T64V`]: crate::gemm::Tiling::T64V
-//! [`Tiling::T128V`]: crate::gemm::Tiling::T128V
+//! [`Tiling::T64V`]: crate::plan::Tiling::T64V
+//! [`Tiling::T128V`]: crate::plan::Tiling::T128V
 
 use cubecl::prelude::*;
 

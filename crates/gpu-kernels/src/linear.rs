@@ -10,7 +10,7 @@
 //! never a per-thread or per-process setting, so a product's arguments say everything that
 //! decides its value.
 
-use crate::gemm::Tiling;
+use crate::plan::{Precision, ShapeError, Tiling, Tuning, bias_blocks, check, splits, takes_bf16};
 use crate::{elementwise, gemm, gemm_cmma, reduce};
 use cubecl::prelude::*;
 use cubecl::server::Handle;
@@ -60,35 +60,9 @@ impl Matrix {
     }
 }
 
-/// An operation that cannot run: operands whose shapes do not fit it, or a [`Precision`] the
-/// device lacks. The message names the operation.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct ShapeError(pub String);
-
-/// The precision of a product's operands; its sums are f32 either way.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum Precision {
-    /// f32 operands, on every device and every [`Tiling`].
-    #[default]
-    F32,
-    /// Operands rounded to bf16 (8 bits of mantissa), multiplied on tensor cores
-    /// ([`crate::gemm_cmma`]); only where [`bf16_supported`] (CUDA on Ampere or later), and
-    /// only for products large enough to gain ([`takes_bf16`]; the others run in f32). The
-    /// tile is the kernel's own; [`Tuning::tiling`] does not apply.
-    Bf16,
-}
-
 /// Whether `client`'s device runs [`Precision::Bf16`] products.
 pub fn bf16_supported(client: &Client) -> bool {
     gemm_cmma::bf16_supported(client)
-}
-
-/// Whether an m x k by k x n product asked for in [`Precision::Bf16`] takes the tensor cores:
-/// products that gain nothing (narrow outputs such as a 3-channel head, a short k, small
-/// products) stay f32. The rule of the CPU's bf16 products (`cpu_kernels::takes_bf16`), so that
-/// both train the same products in bf16.
-pub fn takes_bf16(m: u32, n: u32, k: u32) -> bool {
-    n >= 16 && k >= 8 && u64::from(m) * u64::from(n) * u64::from(k) >= 1 << 18
 }
 
 /// The precision an m x k by k x n product asked for in `precision` runs in ([`takes_bf16`]).
@@ -145,58 +119,8 @@ unsafe fn launch_product(
     }
 }
 
-impl std::fmt::Display for ShapeError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for ShapeError {}
-
-/// The cubes a weight gradient's launch aims for (tiles x splits): about two for each
-/// multiprocessor of a large GPU (an H200 has 132), where one split per 2,048 rows left most of
-/// them idle.
-pub const TARGET_CUBES: u32 = 256;
-/// The fewest batch rows one split sums (unless the batch is shorter).
-pub const MIN_SPLIT_ROWS: u32 = 128;
-/// The most splits of one weight gradient.
-pub const MAX_SPLITS: u32 = 256;
-/// The batch rows of one block of the bias gradient's first pass.
-pub const BIAS_BLOCK_ROWS: u32 = 128;
 /// The most cubes along a grid axis the kernels launch (the limit of Vulkan and WebGPU).
-const MAX_CUBES: u32 = 65_535;
-
-/// How a layer's products are launched beyond their precision: the f32 tile, and the batch
-/// length of every split of a weight gradient.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub struct Tuning {
-    /// The tile of the f32 products (default [`Tiling::T64`]).
-    pub tiling: Tiling,
-    /// A fixed batch length for every split of a weight gradient (`None`: the default rule of
-    /// [`splits`]); [`Tuning::with_split_len`] checks it.
-    pub split_len: Option<u32>,
-}
-
-impl Tuning {
-    /// This tuning with every split of a weight gradient summing `len` batch rows (a power of
-    /// two from 64 to 65,536), or `None` for the default rule of [`splits`]. The number of
-    /// splits, and so the order of every sum, stays a function of the shapes and this value.
-    ///
-    /// # Errors
-    /// A length outside that range.
-    pub fn with_split_len(self, len: Option<u32>) -> Result<Tuning, ShapeError> {
-        if let Some(len) = len {
-            check(len.is_power_of_two() && (64..=65_536).contains(&len), || {
-                format!("split length {len}: expected a power of two from 64 to 65536")
-            })?;
-        }
-        Ok(Tuning { split_len: len, ..self })
-    }
-}
-
-fn check(ok: bool, what: impl FnOnce() -> String) -> Result<(), ShapeError> {
-    if ok { Ok(()) } else { Err(ShapeError(what())) }
-}
+pub(crate) const MAX_CUBES: u32 = 65_535;
 
 fn check_grid(op: &str, cubes: u32) -> Result<(), ShapeError> {
     check(cubes <= MAX_CUBES, || format!("{op}: {cubes} cubes along one axis exceed {MAX_CUBES}"))
@@ -294,27 +218,6 @@ pub fn x_backward(
         );
     }
     Ok(dx)
-}
-
-/// The number of splits of a weight gradient's sum over `rows` whose `[d_in, d_out]` output
-/// takes `tiles` tiles: enough for [`TARGET_CUBES`] cubes in all, each split summing at least
-/// [`MIN_SPLIT_ROWS`] rows, at most [`MAX_SPLITS`] (or `rows / len` for a fixed `split_len`,
-/// [`Tuning::split_len`]). A function of the shapes (and that length) alone.
-pub fn splits(rows: u32, tiles: u32, split_len: Option<u32>) -> u32 {
-    match split_len {
-        None | Some(0) => {
-            let wanted = TARGET_CUBES.div_ceil(tiles.max(1));
-            wanted.min(rows / MIN_SPLIT_ROWS).clamp(1, MAX_SPLITS)
-        }
-        Some(len) => rows.div_ceil(len).clamp(1, MAX_SPLITS),
-    }
-}
-
-/// The blocks of the bias gradient's first pass over `rows`: one per [`BIAS_BLOCK_ROWS`]
-/// rows, at most [`MAX_SPLITS`] (each of its units then sums at most a few hundred values in
-/// either pass).
-pub fn bias_blocks(rows: u32) -> u32 {
-    rows.div_ceil(BIAS_BLOCK_ROWS).clamp(1, MAX_SPLITS)
 }
 
 /// The weight gradient `Xᵀ dY` `[d_in, d_out]` for x `[rows, d_in]` and dY `[rows, d_out]`:
@@ -417,32 +320,4 @@ pub fn relu_backward(client: &Client, x: &Matrix, grad: &Matrix) -> Result<Matri
         );
     }
     Ok(out)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The default rule fills the GPU; a fixed length is taken only when valid.
-    #[test]
-    fn split_counts_follow_the_rule_and_the_length() {
-        // A 128 x 128 gradient on 64-wide tiles (4 tiles) at 2^15: 64 splits of 512 rows.
-        assert_eq!(splits(32_768, 4, None), 64);
-        assert_eq!(splits(32_768, 1, None), 256);
-        assert_eq!(splits(8_192, 4, None), 64);
-        assert_eq!(splits(1_000, 4, None), 7);
-        assert_eq!(splits(1, 4, None), 1);
-        assert_eq!(splits(100_000, 1_000, None), 1);
-        assert_eq!(bias_blocks(32_768), 256);
-        assert_eq!(bias_blocks(1), 1);
-        for bad in [0, 1, 32, 100, 3000, 131_072] {
-            let e = Tuning::default().with_split_len(Some(bad)).unwrap_err().to_string();
-            assert!(e.contains(&bad.to_string()) && e.contains("power of two"), "{e}");
-        }
-        let t = Tuning::default().with_split_len(Some(2048)).unwrap();
-        assert_eq!(splits(32_768, 4, t.split_len), 16);
-        assert_eq!(splits(1, 4, t.split_len), 1);
-        assert_eq!(t.with_split_len(None).unwrap(), Tuning::default());
-        assert_eq!(Tuning::default().tiling, Tiling::T64);
-    }
 }

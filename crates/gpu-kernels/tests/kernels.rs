@@ -12,9 +12,9 @@
 
 use cubecl::prelude::*;
 use gpu_kernels::checks;
-use gpu_kernels::gemm::Tiling;
-use gpu_kernels::linear::Precision::{Bf16, F32};
-use gpu_kernels::linear::{self, Matrix, Tuning};
+use gpu_kernels::linear::{self, Matrix};
+use gpu_kernels::plan::Precision::{Bf16, F32};
+use gpu_kernels::plan::{self, Tiling, Tuning};
 use test_support::assert_close;
 
 /// The runtime under test: `GPU_KERNELS_RUNTIME=cuda` (with the `cuda` feature), else wgpu.
@@ -161,9 +161,9 @@ fn results_are_the_same_bits_on_a_second_run() {
     let dyv = values((rows * d_out) as usize, 8);
     let x = Matrix::upload(&client, &xv, rows, d_in).unwrap();
     let dy = Matrix::upload(&client, &dyv, rows, d_out).unwrap();
-    assert_eq!(linear::splits(rows, 4, None), 64);
+    assert_eq!(plan::splits(rows, 4, None), 64);
     let tu = Tuning::default();
-    assert_eq!(linear::bias_blocks(rows), 157);
+    assert_eq!(plan::bias_blocks(rows), 157);
     let first = linear::weight_backward(&client, &x, &dy, F32, tu).unwrap().read(&client);
     let second = linear::weight_backward(&client, &x, &dy, F32, tu).unwrap().read(&client);
     assert!(first.iter().zip(&second).all(|(a, b)| a.to_bits() == b.to_bits()));
@@ -292,7 +292,7 @@ fn bf16_products_match_the_rounded_reference_or_are_refused() {
         let label = format!("bf16 {rows}x{d_in}x{d_out}");
         // The operands as the product sees them: rounded where it takes the tensor cores.
         let seen = |v: &[f32], (m, n, k): (u32, u32, u32)| {
-            if linear::takes_bf16(m, n, k) { rounded(v) } else { v.to_vec() }
+            if plan::takes_bf16(m, n, k) { rounded(v) } else { v.to_vec() }
         };
 
         let fwd = (rows, d_out, d_in);
@@ -319,7 +319,7 @@ fn bf16_products_match_the_rounded_reference_or_are_refused() {
         assert_close(&format!("Xᵀ dY {label}"), &dw, &want, 4e-7 * m as f64);
 
         // Rounding is what changed where the tensor cores ran.
-        if linear::takes_bf16(rows, d_out, d_in) {
+        if plan::takes_bf16(rows, d_out, d_in) {
             let f32_y = linear::forward(&client, &x, &w, Some(&b.handle), true, F32, tu).unwrap();
             assert_ne!(f32_y.read(&client), y.read(&client), "{label}: bf16 gave the f32 result");
         }
