@@ -301,17 +301,17 @@ unsafe fn add_bias_block(c: *mut f32, ldc: usize, bias: *const f32) {
     }
 }
 
-/// Each thread sums its share of k into its own padded partial, a block of k pairs at a time
-/// (both operands packed per block), then the partials are added in thread order.
+/// Each part of k (`split_k::bf16_parts`, which depends on k alone) is summed into
+/// its own padded partial, a block of k pairs at a time (both operands packed per block), the
+/// parts in parallel; then the partials are added in part order.
 #[cfg(feature = "rayon")]
 unsafe fn split_k(m: usize, n: usize, k: usize, lhs: MatRef, rhs: MatRef, out: *mut f32) {
     use rayon::prelude::*;
-    let threads = rayon::current_num_threads().max(1);
     let pairs = k.div_ceil(2);
-    let per = pairs.div_ceil(threads).next_multiple_of(KT);
+    let (parts, per) = crate::split_k::bf16_parts(pairs, KT);
     let (m_pad, n_pad) = (m.next_multiple_of(MB), n.next_multiple_of(NB));
     let panels = n_pad / NB;
-    let partials: Vec<Vec<f32>> = (0..threads)
+    let partials: Vec<Vec<f32>> = (0..parts)
         .into_par_iter()
         .map(|t| {
             let (p0, p1) = ((t * per).min(pairs), ((t + 1) * per).min(pairs));

@@ -293,17 +293,17 @@ pub(crate) mod x86 {
     /// Pairs per k block of the split-k path: the packed blocks of both operands stay in L2.
     const KC_PAIRS: usize = 256;
 
-    /// Each thread sums its share of k into its own m x n partial, a block of k at a time
-    /// (both operands packed per block, cache-hot), then the partials are added.
+    /// Each part of k (`split_k::bf16_parts`) is summed into its own m x n partial, a block of
+    /// k at a time (both operands packed per block, cache-hot), the parts in parallel; then the
+    /// partials are added in part order.
     #[cfg(feature = "rayon")]
     unsafe fn split_k(m: usize, n: usize, k: usize, lhs: MatRef, rhs: MatRef, out: *mut f32) {
         use rayon::prelude::*;
-        let threads = rayon::current_num_threads().max(1);
         let pairs = k.div_ceil(2);
-        let per = pairs.div_ceil(threads);
+        let (parts, per) = crate::split_k::bf16_parts(pairs, 1);
         let panels = n.div_ceil(NR);
         let tiles = m.div_ceil(MR);
-        let partials: Vec<Vec<f32>> = (0..threads)
+        let partials: Vec<Vec<f32>> = (0..parts)
             .into_par_iter()
             .map(|t| {
                 let (p0, p1) = (t * per, ((t + 1) * per).min(pairs));
@@ -344,15 +344,12 @@ pub(crate) mod x86 {
             })
             .collect();
         let out = SendPtr(out);
-        let rows_per = m.div_ceil(threads);
-        (0..threads).into_par_iter().for_each(|t| {
-            for i in t * rows_per..((t + 1) * rows_per).min(m) {
-                let dst = unsafe { core::slice::from_raw_parts_mut(out.get().add(i * n), n) };
-                dst.copy_from_slice(&partials[0][i * n..(i + 1) * n]);
-                for part in &partials[1..] {
-                    for (d, s) in dst.iter_mut().zip(&part[i * n..(i + 1) * n]) {
-                        *d += s;
-                    }
+        (0..m).into_par_iter().with_min_len(16).for_each(|i| {
+            let dst = unsafe { core::slice::from_raw_parts_mut(out.get().add(i * n), n) };
+            dst.copy_from_slice(&partials[0][i * n..(i + 1) * n]);
+            for part in &partials[1..] {
+                for (d, s) in dst.iter_mut().zip(&part[i * n..(i + 1) * n]) {
+                    *d += s;
                 }
             }
         });

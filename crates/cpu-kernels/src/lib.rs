@@ -13,8 +13,8 @@
 //! | f32 gemm (the `gemm` crate, as burn-flex calls it) | everything else | [`gemm_f32`] |
 //!
 //! A product's value depends on its operands, shape and precision only, never on the thread
-//! count: split-k's block count depends on k alone, and gemm parallelises over the output, not
-//! over k. A bias is added after the sum with one f32 addition per element, so `matmul` with a
+//! count: the f32 and bf16 split-k's parts depend on k alone, and gemm and the bf16 kernels'
+//! rows parallelise over the output, not over k. A bias is added after the sum with one f32 addition per element, so `matmul` with a
 //! bias equals `matmul` without it followed by the broadcast add, to the bit.
 //!
 //! The precision is an argument of every call, and with it whether a bf16 product takes the

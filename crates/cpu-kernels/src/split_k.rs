@@ -1,4 +1,5 @@
-//! f32 products with a long inner dimension and a small output, split over k.
+//! Products with a long inner dimension and a small output, split over k: the f32 product here,
+//! and the split of the bf16 kernels' (`bf16_parts`, used by `bf16dot` and `amx`).
 //!
 //! A training step's weight gradients are `Xᵀ dY`: [d_in, batch] x [batch, d_out], an output
 //! of at most a few hundred squared summed over tens of thousands of samples. The gemm crate
@@ -37,6 +38,22 @@ pub fn split_k_blocks(m: usize, n: usize, k: usize) -> usize {
         return 1;
     }
     (k / BLOCK_K).min(MAX_BLOCKS)
+}
+
+/// k pairs per part of a bf16 product split over k (the weight gradients, summed over the
+/// batch), and the most parts: a batch of 2^13 gives 8 parts, one of 2^15 32.
+const PART_PAIRS: usize = 512;
+const MAX_PARTS: usize = 32;
+
+/// How a bf16 product of `pairs` k pairs is split over k: (parts, pairs per part, a multiple of
+/// `align`). The split depends on k alone, not on the thread count, so that a product's bits
+/// are the same however many threads run it (a `--jobs` child, a Slurm task, a workstation), as
+/// for the f32 split above; the threads share the parts.
+#[cfg_attr(not(feature = "rayon"), allow(dead_code))]
+pub(crate) fn bf16_parts(pairs: usize, align: usize) -> (usize, usize) {
+    let parts = (pairs / PART_PAIRS).clamp(1, MAX_PARTS);
+    let per = pairs.div_ceil(parts).next_multiple_of(align.max(1));
+    (pairs.div_ceil(per).max(1), per)
 }
 
 /// A read-only strided matrix operand: element (i, j) at `ptr + i rs + j cs`.
@@ -200,6 +217,21 @@ mod tests {
         assert_eq!(split_k_blocks(512, 512, 32_768), 1);
         assert_eq!(split_k_blocks(32_768, 128, 128), 1);
         assert_eq!(split_k_blocks(0, 128, 32_768), 1);
+    }
+
+    #[test]
+    fn bf16_parts_depend_on_k_alone_and_cover_it() {
+        assert_eq!(bf16_parts(1_024, 1), (2, 512), "k = 2,048: two parts");
+        assert_eq!(bf16_parts(4_096, 1), (8, 512), "a batch of 2^13");
+        assert_eq!(bf16_parts(16_384, 16), (32, 512), "a batch of 2^15");
+        assert_eq!(bf16_parts(1 << 20, 16), (32, 32_768), "at most 32 parts");
+        for pairs in [1, 7, 511, 1_000, 1_025, 4_097, 20_001, 70_000] {
+            for align in [1, 16] {
+                let (parts, per) = bf16_parts(pairs, align);
+                assert_eq!(per % align, 0, "{pairs} {align}");
+                assert!(parts >= 1 && parts * per >= pairs && (parts - 1) * per < pairs, "{pairs}");
+            }
+        }
     }
 
     #[test]

@@ -47,4 +47,4 @@ pub use test_metrics::{CurvePoint, EnergySummary, ImageMetrics, TestMetrics};
 /// The version of the code that results depend on: bump it with any change that alters a
 /// result (training, models, data generation or metrics), so that content-addressed runs of
 /// the old code are not reused.
-pub const CODE_VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), "+results-3");
+pub const CODE_VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), "+results-4");
