@@ -107,45 +107,7 @@ enum Command {
     /// Reproduce the paper's tables and figures: generate the profile's scenes, fit and evaluate
     /// every run (finished runs are skipped, interrupted ones resume), then write the tables
     /// (Markdown, LaTeX) and figures (PNG) into OUT/tables and OUT/figures.
-    ReproduceTables {
-        /// Built-in profile (default, quick, smoke, runtime, full, real, figure, all-tables) or a
-        /// profile TOML file.
-        #[arg(long, default_value = sweep::DEFAULT_PROFILE)]
-        profile: String,
-        /// Output directory (scenes, runs, cache, tables, figures).
-        #[arg(long, default_value = "out/reproduce")]
-        out: PathBuf,
-        /// Runs at a time, as child processes (1: in this process) [default: 2 on the CPU, where
-        /// two use a 2-core machine fully (one training run keeps about 1.5 cores busy); 1 on a
-        /// GPU].
-        #[arg(long)]
-        jobs: Option<usize>,
-        /// Write one shell command per unfinished run to this file (e.g. for a Slurm job array)
-        /// instead of running them; then `cargo xtask collect`.
-        #[arg(long)]
-        emit_jobs: Option<PathBuf>,
-        /// Data root for the profile's `data:` meshes and its captures (default:
-        /// $NEURAL_BRDF_DATA, else ./data).
-        #[arg(long)]
-        data: Option<PathBuf>,
-        /// The burn backend of every run: `cpu` (default), `wgpu` or `cuda` (an xtask built with
-        /// `--features wgpu` or `cuda`). On a GPU, use `--jobs 1`.
-        #[arg(long, default_value = "cpu", value_parser = parse_backend)]
-        backend: Backend,
-        /// Precision of the training steps' matrix products, for every run: `f32` or `bf16`
-        /// (CPU backend; about 1.5x faster fits on AVX512-BF16 CPUs, see docs/guide.md). Without it,
-        /// the profile's `run.train.matmul_precision` holds (f32 unless it says otherwise).
-        /// bf16 runs get their own run ids.
-        #[arg(long, value_parser = parse_precision)]
-        matmul_precision: Option<MatmulPrecision>,
-        /// Only the runs of these tables of the paper, comma-separated: table1, energy, nol,
-        /// reciprocity, view-light, nerfactor (`--tables table1` on `--profile all-tables`
-        /// is the default's Table 1 alone). Without it, every table the profile plans.
-        #[arg(long, value_delimiter = ',')]
-        tables: Option<Vec<String>>,
-        #[command(flatten)]
-        slurm: SlurmArgs,
-    },
+    ReproduceTables(ReproduceArgs),
     /// Where a sweep's runs stand (done, running, failed, interrupted, pending), read from the
     /// run directories: also after its Slurm jobs have left the queue.
     SweepStatus {
@@ -254,6 +216,68 @@ enum Command {
     /// as the `experiments` binary's.
     #[command(flatten)]
     Run(RunCommand),
+}
+
+/// The options of `reproduce-tables`.
+#[derive(Args)]
+struct ReproduceArgs {
+    /// Built-in profile (default: every table of the paper; quick, smoke, runtime, full, real,
+    /// figure; all-tables is default's old name) or a profile TOML file.
+    #[arg(long, default_value = sweep::DEFAULT_PROFILE)]
+    profile: String,
+    /// Output directory (scenes, runs, cache, tables, figures).
+    #[arg(long, default_value = "out/reproduce")]
+    out: PathBuf,
+    /// Runs at a time, as child processes (1: in this process) [default: 2 on the CPU, where
+    /// two use a 2-core machine fully (one training run keeps about 1.5 cores busy); 1 on a
+    /// GPU].
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// Write one shell command per unfinished run to this file (e.g. for a Slurm job array)
+    /// instead of running them; then `cargo xtask collect`.
+    #[arg(long)]
+    emit_jobs: Option<PathBuf>,
+    /// Data root for the profile's `data:` meshes and its captures (default:
+    /// $NEURAL_BRDF_DATA, else ./data).
+    #[arg(long)]
+    data: Option<PathBuf>,
+    /// The burn backend of every run: `cpu` (default), `wgpu` or `cuda` (an xtask built with
+    /// `--features wgpu` or `cuda`). On a GPU, use `--jobs 1`.
+    #[arg(long, default_value = "cpu", value_parser = parse_backend)]
+    backend: Backend,
+    /// Precision of the training steps' matrix products, for every run: `f32` or `bf16`
+    /// (CPU backend; about 1.5x faster fits on AVX512-BF16 CPUs, see docs/guide.md). Without it,
+    /// the profile's `run.train.matmul_precision` holds where it names one; otherwise, on the
+    /// CPU, bf16 where this CPU runs it natively and faster (AMX tiles, or AVX512-BF16
+    /// without AMX) and f32 elsewhere, printed at the start. bf16 runs get their own run ids.
+    #[arg(long, value_parser = parse_precision)]
+    matmul_precision: Option<MatmulPrecision>,
+    /// Only the runs of these tables of the paper, comma-separated: table1, energy, nol,
+    /// reciprocity, view-light, nerfactor (`--tables table1`: the default's Table 1 alone).
+    /// Without it, every table the profile plans.
+    #[arg(long, value_delimiter = ',')]
+    tables: Option<Vec<String>>,
+    #[command(flatten)]
+    slurm: SlurmArgs,
+}
+
+impl ReproduceArgs {
+    /// The sweep's options, with the places the command line read.
+    fn options(self, places: experiments::places::Places) -> Result<reproduce::Options> {
+        let backend = self.backend;
+        Ok(reproduce::Options {
+            profile: self.profile,
+            out: self.out,
+            jobs: self.jobs.unwrap_or(if backend.is_gpu() { 1 } else { 2 }),
+            emit_jobs: self.emit_jobs,
+            lpips_weights: places.clone().with_data(self.data.as_deref()).lpips_weights(),
+            data_root: self.data.unwrap_or(places.data),
+            backend,
+            matmul_precision: self.matmul_precision,
+            tables: self.tables,
+            slurm: self.slurm.options()?,
+        })
+    }
 }
 
 /// The Slurm flags of `reproduce-tables` (docs/guide.md, "On a cluster").
@@ -376,30 +400,7 @@ fn main() -> Result<()> {
             let dest = dest.unwrap_or(places.data);
             fetch::run(fetch::Options { name, dest, only, list, allow_unverified, manifests })?;
         }
-        Command::ReproduceTables {
-            profile,
-            out,
-            jobs,
-            emit_jobs,
-            data,
-            backend,
-            matmul_precision,
-            tables,
-            slurm,
-        } => {
-            reproduce::reproduce(reproduce::Options {
-                profile,
-                out,
-                jobs: jobs.unwrap_or(if backend.is_gpu() { 1 } else { 2 }),
-                emit_jobs,
-                lpips_weights: places.clone().with_data(data.as_deref()).lpips_weights(),
-                data_root: data.unwrap_or(places.data),
-                backend,
-                matmul_precision,
-                tables,
-                slurm: slurm.options()?,
-            })?;
-        }
+        Command::ReproduceTables(args) => reproduce::reproduce(args.options(places)?)?,
         Command::SweepStatus { out } => slurm::status(&out)?,
         Command::SlurmCollect { out } => slurm::collect(&out)?,
         Command::SlurmResubmit { out, unfinished, dry_run } => {

@@ -60,10 +60,7 @@ pub fn reproduce(opts: Options) -> Result<()> {
         "--matmul-precision bf16 is implemented for the CPU backend only, not --backend {}",
         opts.backend
     );
-    let mut profile = SweepProfile::load(&opts.profile)?;
-    if let Some(precision) = opts.matmul_precision {
-        profile = profile.with_matmul_precision(precision);
-    }
+    let mut profile = with_precision(SweepProfile::load(&opts.profile)?, &opts);
     if let Some(tables) = &opts.tables {
         profile = profile.with_tables(tables)?;
     }
@@ -120,6 +117,26 @@ pub fn reproduce(opts: Options) -> Result<()> {
         s.failed.len()
     );
     Ok(())
+}
+
+/// The profile with its training products' precision: `--matmul-precision` where given, the
+/// profile's own where it names one, and otherwise, on the CPU, the machine's choice (bf16 where
+/// it is native and faster, whose converged scores stay within f32's seed noise:
+/// docs/reproduce.md, "bf16 as the CPU default"), printed with its reason.
+fn with_precision(profile: SweepProfile, opts: &Options) -> SweepProfile {
+    if let Some(precision) = opts.matmul_precision {
+        return profile.with_matmul_precision(precision);
+    }
+    if opts.backend != Backend::Flex || profile.names_precision {
+        return profile;
+    }
+    let (precision, why) = experiments::cli::cpu_default_precision();
+    eprintln!(
+        "matmul precision {}: {why} (`--matmul-precision f32` or `bf16` chooses; bf16 runs have \
+         their own run ids)",
+        precision.name()
+    );
+    profile.with_matmul_precision(precision)
 }
 
 /// The sweep's own settings: the progress lines (`NEURAL_BRDF_PROGRESS_LINES`, `_SECS`), the

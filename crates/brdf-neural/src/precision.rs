@@ -46,6 +46,17 @@ pub trait PrecisionSupport {
 
     /// Whether this CPU runs bf16 products natively (otherwise they are emulated, slowly).
     fn bf16_native() -> bool;
+
+    /// The precision a CPU run takes when neither its configuration nor the command line names
+    /// one: bf16 where it is faster than f32 here (AMX tiles granted, or AVX512-BF16 on a CPU
+    /// without AMX), f32 elsewhere (emulated bf16, and the AVX512-BF16 kernel on an AMX Xeon
+    /// whose tiles Linux did not grant, are slower than f32). `docs/reproduce.md` ("bf16 as the
+    /// CPU default") gives the measurements that keep bf16's converged scores within f32's
+    /// seed noise.
+    fn cpu_default() -> MatmulPrecision {
+        let faster = Self::bf16_on_amx() || (Self::bf16_native() && !Self::cpu_has_amx_bf16());
+        if faster { MatmulPrecision::Bf16 } else { MatmulPrecision::F32 }
+    }
 }
 
 impl PrecisionSupport for MatmulPrecision {
@@ -125,5 +136,20 @@ mod tests {
         };
         let kernel = flags.split_whitespace().any(|f| f == "amx_bf16");
         assert_eq!(MatmulPrecision::cpu_has_amx_bf16(), kernel, "{flags}");
+    }
+
+    /// The CPU default is bf16 exactly where bf16 runs natively and faster than f32.
+    #[test]
+    fn the_cpu_default_is_bf16_only_where_it_is_native_and_faster() {
+        let d = MatmulPrecision::cpu_default();
+        if !MatmulPrecision::bf16_native() {
+            assert_eq!(d, MatmulPrecision::F32, "emulated bf16 is slower than f32");
+        }
+        if MatmulPrecision::bf16_on_amx() {
+            assert_eq!(d, MatmulPrecision::Bf16);
+        }
+        if MatmulPrecision::cpu_has_amx_bf16() && !MatmulPrecision::bf16_on_amx() {
+            assert_eq!(d, MatmulPrecision::F32, "AVX512-BF16 on an AMX Xeon is slower than f32");
+        }
     }
 }

@@ -12,6 +12,7 @@ use crate::places::Places;
 use crate::{FitOptions, FitOutcome};
 use anyhow::{Context, Result, bail};
 use brdf_neural::device::Backend;
+use brdf_neural::precision::{MatmulPrecision, PrecisionSupport};
 use clap::Subcommand;
 use run_format::config::RunConfig;
 use run_format::run_dir::RunDir;
@@ -63,6 +64,24 @@ pub fn process_limits() -> Result<stdx::Limits> {
         }
     }
     Ok(limits)
+}
+
+/// The precision of the training products on this CPU when neither the command line nor the
+/// configuration names one ([`PrecisionSupport::cpu_default`]), with the reason in words for
+/// the command line to print.
+pub fn cpu_default_precision() -> (MatmulPrecision, &'static str) {
+    let p = MatmulPrecision::cpu_default();
+    let why = match p {
+        MatmulPrecision::Bf16 if MatmulPrecision::bf16_on_amx() => {
+            "this CPU runs bf16 products on its AMX tiles"
+        }
+        MatmulPrecision::Bf16 => "this CPU runs bf16 products natively (AVX512-BF16)",
+        _ if MatmulPrecision::cpu_has_amx_bf16() => {
+            "this CPU has AMX, but Linux did not grant its tiles to this process"
+        }
+        _ => "this CPU has no native bf16 products",
+    };
+    (p, why)
 }
 
 /// A command on one run: fit, evaluate, analyse or export it.

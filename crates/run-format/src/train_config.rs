@@ -60,8 +60,9 @@
 //! `smoothing = 3` watches the mean of the last 3 validation losses instead of each one: at 1e-3
 //! a metal's loss jitters by 4 to 8 % between validations, against a trend of 2 to 4 % per 300
 //! steps, and the single-loss rule decays on a lucky low as often as on a plateau, so where a
-//! run decays, and what it converges to, is partly a draw (opt-in until the default's tables
-//! are measured with it). The regulariser
+//! run decays, and what it converges to, is partly a draw. The sweep's `default` profile sets
+//! it; the training profiles keep 1, so that their run ids and results stay those measured.
+//! The regulariser
 //! weights are the paper's (enhanced split, spec 4.5) and apply to the enhanced additive
 //! models only. `output_init = "data"` starts every model's output layer (FMBRDF's excepted) at the
 //! least-squares constant BRDF of the training records (experiments' `RecordSet::mean_brdf`),

@@ -350,8 +350,13 @@ pub fn execute(
     progress: &ProgressLines,
     summary: &mut SweepSummary,
 ) -> Result<()> {
-    let todo: Vec<&PathBuf> = dirs.iter().filter(|d| !is_done(d)).collect();
+    let mut todo: Vec<&PathBuf> = dirs.iter().filter(|d| !is_done(d)).collect();
     summary.skipped = dirs.len() - todo.len();
+    if let Execution::Children { jobs, .. } = how
+        && *jobs > 1
+    {
+        longest_first(&mut todo);
+    }
     let bar = stdx::progress::bar(todo.len() as u64, "runs", "sweep", true);
     let lines = match how {
         Execution::InProcess(_) => Heartbeat::start(todo.len(), 1, progress),
@@ -371,6 +376,24 @@ pub fn execute(
     }
     bar.finish_and_clear();
     Ok(())
+}
+
+/// Orders runs by their expected training time, longest first (a stable sort: runs of one cost
+/// keep the plan's order), so that several at a time end together instead of one core
+/// finishing a long run alone. A run whose configuration does not read keeps its place at the
+/// end, where its own start reports the fault.
+fn longest_first(todo: &mut [&PathBuf]) {
+    let cost = |d: &PathBuf| {
+        RunDir::new(d.as_path())
+            .read_config()
+            .map(|c| crate::slurm::requests::expected_seconds(&c, Backend::Flex))
+            .unwrap_or(0.0)
+    };
+    let mut keyed: Vec<(f64, &PathBuf)> = todo.iter().map(|d| (cost(d), *d)).collect();
+    keyed.sort_by(|a, b| b.0.total_cmp(&a.0));
+    for (slot, (_, d)) in todo.iter_mut().zip(keyed) {
+        *slot = d;
+    }
 }
 
 /// Runs `todo` one after the other in this process.

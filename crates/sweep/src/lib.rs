@@ -1,7 +1,7 @@
 //! Sweeps: the whole reproduction (`cargo xtask reproduce-tables`) and `collect`.
 //!
 //! * [`profile`]: the sweep profiles (`default`, `smoke`, `quick`, `runtime`, `full`, `real`,
-//!   `figure`, `all-tables`, or a TOML file).
+//!   `figure`; `all-tables` is an alias of `default`; or a TOML file).
 //! * [`plan`]: scenes and runs of a profile, content-addressed run directories.
 //! * [`execute`]: scene generation, shared LBO tables, runs in-process, as child processes
 //!   (`--jobs`) or as a job file for a cluster (`--emit-jobs`).

@@ -1,7 +1,8 @@
 //! Sweep profiles: which scenes, models, ablations and training budgets a reproduction runs.
 //!
 //! A profile is a TOML file. The built-in ones live in `crates/sweep/profiles/` and are
-//! compiled in (`default`, `smoke`, `quick`, `runtime`, `full`, `real`, `figure`, `all-tables`);
+//! compiled in (`default`, `smoke`, `quick`, `runtime`, `full`, `real`, `figure`; `all-tables` is
+//! an alias of `default`);
 //! `--profile` takes one of those names or a path to a file of the same shape:
 //!
 //! ```toml
@@ -42,7 +43,7 @@ use serde::Deserialize;
 use std::path::Path;
 
 /// The built-in profiles: (name, TOML text).
-pub const BUILT_IN: [(&str, &str); 8] = [
+pub const BUILT_IN: [(&str, &str); 7] = [
     ("default", include_str!("../profiles/default.toml")),
     ("smoke", include_str!("../profiles/smoke.toml")),
     ("quick", include_str!("../profiles/quick.toml")),
@@ -50,12 +51,15 @@ pub const BUILT_IN: [(&str, &str); 8] = [
     ("full", include_str!("../profiles/full.toml")),
     ("real", include_str!("../profiles/real.toml")),
     ("figure", include_str!("../profiles/figure.toml")),
-    ("all-tables", include_str!("../profiles/all-tables.toml")),
 ];
 
-/// The profile `reproduce-tables` runs without `--profile`: Table 1 with every run trained to
-/// its plateau on three scenes of the shipped Spot mesh (no download), and the run-time curve
-/// of the first scene.
+/// Other names of built-in profiles: (alias, profile). `all-tables` was the every-table
+/// profile before the default became it.
+pub const ALIASES: [(&str, &str); 1] = [("all-tables", "default")];
+
+/// The profile `reproduce-tables` runs without `--profile`: every table of the paper with every
+/// run trained to its plateau, on three scenes of the shipped Spot mesh (no download) and on
+/// the DiLiGenT ball when it is under the data root.
 pub const DEFAULT_PROFILE: &str = "default";
 
 /// The scenes of a profile: semi-synthetic ones (meshes x materials) and real captures.
@@ -154,6 +158,10 @@ pub struct SweepProfile {
     pub sweep: SweepSection,
     /// Where it came from (a built-in name or a path), for errors.
     pub origin: String,
+    /// Whether its `[run.train]` names `matmul_precision` (otherwise the command line may
+    /// choose one for the machine: `reproduce-tables` takes bf16 where the CPU runs it
+    /// natively).
+    pub names_precision: bool,
 }
 
 #[derive(Deserialize)]
@@ -190,8 +198,10 @@ pub enum Ablation {
 impl SweepProfile {
     /// A built-in profile by name, or the file at `name_or_path`.
     pub fn load(name_or_path: &str) -> Result<Self> {
-        if let Some((_, text)) = BUILT_IN.iter().find(|(n, _)| *n == name_or_path) {
-            return Self::parse(text, &format!("built-in profile {name_or_path}"));
+        let name =
+            ALIASES.iter().find(|(a, _)| *a == name_or_path).map_or(name_or_path, |(_, n)| n);
+        if let Some((_, text)) = BUILT_IN.iter().find(|(n, _)| *n == name) {
+            return Self::parse(text, &format!("built-in profile {name}"));
         }
         let path = Path::new(name_or_path);
         if !path.is_file() {
@@ -211,6 +221,11 @@ impl SweepProfile {
     /// Parses profile text; `origin` names it in errors.
     pub fn parse(text: &str, origin: &str) -> Result<Self> {
         let raw: RawProfile = toml::from_str(text).map_err(|e| parse_error(origin, e))?;
+        let names_precision = raw
+            .run
+            .get("train")
+            .and_then(|t| t.as_table())
+            .is_some_and(|t| t.contains_key("matmul_precision"));
         let run = toml::to_string(&raw.run).map_err(|e| parse_error(origin, e))?;
         let run = RunConfig::from_toml(&run, Path::new(&format!("{origin} [run]")))?;
         let p = SweepProfile {
@@ -220,6 +235,7 @@ impl SweepProfile {
             run,
             sweep: raw.sweep,
             origin: origin.into(),
+            names_precision,
         };
         p.validate().map_err(|e| e.in_file(origin))?;
         Ok(p)
@@ -230,6 +246,7 @@ impl SweepProfile {
     /// never mixes precisions in one run directory.
     pub fn with_matmul_precision(mut self, precision: MatmulPrecision) -> Self {
         self.run.train.matmul_precision = precision;
+        self.names_precision = true;
         self
     }
 
@@ -412,7 +429,8 @@ mod tests {
 
     #[test]
     fn tables_keep_their_ablations_only() {
-        let all = SweepProfile::load("all-tables").unwrap();
+        let all = SweepProfile::load("default").unwrap();
+        assert_eq!(SweepProfile::load("all-tables").unwrap(), all, "the alias");
         let t1 = all.clone().with_tables(&["table1".into()]).unwrap();
         assert!(t1.sweep.ablations.is_empty());
         assert_eq!(t1.models().unwrap().len(), 9);
@@ -430,11 +448,18 @@ mod tests {
             assert!(p.scene_count() >= 1);
             assert!(!p.models().unwrap().is_empty() || p.sweep.runtime_curve);
         }
-        for name in ["default", "quick"] {
+        for (name, scenes) in [("default", 4), ("quick", 3)] {
             let p = SweepProfile::load(name).unwrap();
             assert_eq!(p.models().unwrap().len(), 9);
-            assert_eq!(p.scene_count(), 3);
+            assert_eq!(p.scene_count(), scenes, "{name}: 3 Spot scenes, the ball optional");
+            assert!(!p.names_precision, "{name}: the machine chooses");
         }
+        let mut named =
+            BUILT_IN[0].1.replace("[run.train]", "[run.train]\nmatmul_precision = \"f32\"");
+        assert!(SweepProfile::parse(&named, "test").unwrap().names_precision);
+        named = BUILT_IN[0].1.to_string();
+        let p = SweepProfile::parse(&named, "test").unwrap();
+        assert!(p.with_matmul_precision(MatmulPrecision::F32).names_precision);
     }
 
     #[test]

@@ -84,6 +84,33 @@ fn step_ms(kind: ModelKind, gpu: bool) -> f64 {
     if gpu { h200 } else { cpu }
 }
 
+/// The steps a run of `kind` typically trains before its plateau rule stops it: the means of
+/// the default profile's Table 1 runs (docs/reproduce.md, "What the default run shows").
+fn typical_steps(kind: ModelKind) -> u64 {
+    use ModelKind::*;
+    match kind {
+        Rp => 900,
+        Ts => 800,
+        Disney => 1_000,
+        SingleMlp => 1_700,
+        AdditiveSeparateEnhanced => 1_700,
+        AdditiveSharedEnhanced => 2_100,
+        AdditiveSeparate | AdditiveShared => 2_200,
+        Fmbrdf => 2_700,
+    }
+}
+
+/// A rough guess at a run's training seconds on `backend`, before it ran: its typical steps to
+/// the plateau (at most its budget) at the measured step time. Only the order matters: the
+/// sweep starts the longest runs first, so that the last to finish are short ones and no core
+/// waits long for them.
+pub fn expected_seconds(config: &RunConfig, backend: Backend) -> f64 {
+    let t = &config.train;
+    let scale = (t.batch_size as f64 / 32768.0).max(1.0 / 16.0);
+    let steps = typical_steps(config.model.kind).min(t.iterations) as f64;
+    steps * step_ms(config.model.kind, backend.is_gpu()) * scale / 1000.0
+}
+
 /// Settings of the requests that are not measured: the user's (`--slurm-cpus`, `--slurm-mem`,
 /// `--slurm-max-time`) or the defaults.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
