@@ -170,19 +170,18 @@ pub fn fit_and_keep(
     options: FitOptions,
 ) -> Result<(FitOutcome, Option<Trained>)> {
     let started = std::time::Instant::now();
-    let (config, finished) = held.begin_training(config)?;
-    if let Some(metrics) = finished {
+    let begun = held.begin_training(config, options.cache_dir.as_deref())?;
+    if let Some(metrics) = begun.finished {
         return Ok((FitOutcome::AlreadyFinished(metrics), None));
     }
-    let config = &config;
+    let (config, cache, last_checkpoint) = (&begun.config, begun.cache, begun.checkpoint);
     let dir = held.dir();
-    let cache = dir.cache(config, options.cache_dir.as_deref());
     let RunData { scene, train: data, val, val_floor } =
         training_data(config, (&cache, options.compute.lbo_memory_bytes()))?;
     let t = &config.train;
 
     let device = options.backend.training_device()?;
-    let (model, mut optim, state, last_checkpoint) = start(config, dir, &data, &device)?;
+    let (model, mut optim, state) = start(config, last_checkpoint.as_deref(), &data, &device)?;
     let resumed_from = state.step;
     if resumed_from > 0 {
         eprintln!("{}: resuming from the checkpoint at step {resumed_from}", dir.path().display());
@@ -242,26 +241,21 @@ pub fn fit_and_keep(
 }
 
 /// The model, optimiser and loop state training starts from: the seeded initialisation, or
-/// the last checkpoint of `dir` (returned too) when there is one.
-#[allow(clippy::type_complexity)]
+/// the checkpoint `checkpoint` when there is one.
 fn start(
     config: &RunConfig,
-    dir: &RunDir,
+    checkpoint: Option<&Path>,
     data: &RecordSet,
     device: &Device,
-) -> Result<(BrdfModel, ModuleOptimizer, CheckpointState, Option<PathBuf>)> {
+) -> Result<(BrdfModel, ModuleOptimizer, CheckpointState)> {
     let t = &config.train;
     let initial_brdf = (t.output_init == OutputInit::Data).then(|| data.mean_brdf());
     let model = BrdfModel::init_seeded(&config.model, device, config.seed, initial_brdf)?;
     let optim = AdamConfig::new().with_epsilon(t.adam_epsilon as f32).init();
-    let last_checkpoint = dir.latest_checkpoint()?;
-    Ok(match &last_checkpoint {
-        Some(c) => {
-            let (model, optim, state) = checkpoint::load(c, model, optim)?;
-            (model, optim, state, last_checkpoint)
-        }
-        None => (model, optim, CheckpointState::default(), None),
-    })
+    match checkpoint {
+        Some(c) => checkpoint::load(c, model, optim),
+        None => Ok((model, optim, CheckpointState::default())),
+    }
 }
 
 /// The training and validation records' inputs kept on the device when `on_device`: the

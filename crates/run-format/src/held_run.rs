@@ -10,7 +10,7 @@
 use crate::config::RunConfig;
 use crate::run_dir::{CurveRow, RunDir, RunMetrics, write_curve};
 use crate::{Error, Result};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// A run directory whose lock this process holds (released when dropped).
 #[derive(Debug)]
@@ -25,14 +25,17 @@ impl HeldRun {
         &self.dir
     }
 
-    /// Checks the directory before a fit trains it and returns the configuration to train,
-    /// with the metrics of a run that already finished training. `None` trains the
-    /// configuration the directory holds (a sweep's prepared run); a given one is checked, a
-    /// new run gets it as its `config.toml`, and an existing run must hold the same.
+    /// Reads what a fit starts from, at once: checks the directory against the configuration
+    /// to train and returns it, with its cache directory (`cache` overrides the configured
+    /// one), the metrics of a run that already finished training and the newest complete
+    /// checkpoint to resume from. `config: None` trains the configuration the directory holds
+    /// (a sweep's prepared run); a given one is checked, a new run gets it as its
+    /// `config.toml`, and an existing run must hold the same.
     pub fn begin_training(
         &self,
         config: Option<&RunConfig>,
-    ) -> Result<(RunConfig, Option<RunMetrics>)> {
+        cache: Option<&Path>,
+    ) -> Result<TrainingStart> {
         let path = self.dir.config();
         let config = match config {
             None => self.dir.read_config()?,
@@ -55,14 +58,30 @@ impl HeldRun {
             Some(given) => {
                 given.validate()?;
                 stdx::fs::write_atomic(&path, given.to_toml()?.as_bytes())?;
-                return Ok((given.clone(), None));
+                given.clone()
             }
         };
         config.validate()?;
         let finished =
             if self.dir.is_trained() { Some(RunMetrics::read(&self.dir.metrics())?) } else { None };
-        Ok((config, finished))
+        let cache = self.dir.cache(&config, cache);
+        let checkpoint = self.dir.latest_checkpoint()?;
+        Ok(TrainingStart { config, cache, finished, checkpoint })
     }
+}
+
+/// What [`HeldRun::begin_training`] read: all a fit needs from its run directory before it
+/// trains.
+#[derive(Debug)]
+pub struct TrainingStart {
+    /// The configuration to train.
+    pub config: RunConfig,
+    /// The eigenpair and feature cache directory.
+    pub cache: PathBuf,
+    /// The metrics of a run that already finished training (`None`: it trains).
+    pub finished: Option<RunMetrics>,
+    /// The newest complete checkpoint, which training resumes from.
+    pub checkpoint: Option<PathBuf>,
 }
 
 impl HeldRun {
@@ -80,6 +99,23 @@ impl HeldRun {
     ) -> std::result::Result<(), E> {
         write_curve(&self.dir.curve(), curve)?;
         write_weights(&self.dir.weights())?;
+        metrics.write(&self.dir.metrics())?;
+        Ok(())
+    }
+}
+
+impl HeldRun {
+    /// Writes what marks the run evaluated: the probe first (`write_probe` writes it,
+    /// atomically, to the path it is given; `None`: no probe), `metrics` (with its test
+    /// record) last, so that a kill between them leaves a run that evaluates again.
+    pub fn write_evaluated<E: From<Error>>(
+        &self,
+        write_probe: Option<impl FnOnce(&Path) -> std::result::Result<(), E>>,
+        metrics: &RunMetrics,
+    ) -> std::result::Result<(), E> {
+        if let Some(write) = write_probe {
+            write(&self.dir.probe())?;
+        }
         metrics.write(&self.dir.metrics())?;
         Ok(())
     }

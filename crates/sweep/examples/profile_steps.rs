@@ -146,7 +146,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let (outcome, trained) = fit_and_keep(Some(&config), &held, options())?;
         let trained = trained.ok_or_else(|| format!("{kind}: did not train ({outcome:?})"))?;
         let metrics = run_format::RunMetrics::read(&RunDir::new(&run).metrics())?;
-        let phases = metrics.phases.unwrap_or_default();
+        let phases = metrics.phases.clone().unwrap_or_default();
         let cells: Vec<String> =
             phases.per_step_ms().iter().map(|(_, ms)| format!("{ms:.1}")).collect();
         let total = 1e3 * phases.total() / phases.steps.max(1) as f64;
@@ -161,7 +161,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let fitted = trained.into_fitted();
         for round in 1..=eval_repeat {
             let start = Instant::now();
-            let test = eval_fitted(&fitted, &held, &Default::default(), start)?;
+            let test = eval_fitted(&fitted, &held, metrics.clone(), &Default::default(), start)?;
             let cells: Vec<String> =
                 test.phases.named().iter().map(|(name, s)| format!("{name} {s:.2}")).collect();
             eprintln!(

@@ -178,7 +178,7 @@ fn fit_evaluate_export(held: &HeldRun, progress: bool, on: &RunOn) -> Result<Run
     let backend = on.backend;
     let options =
         FitOptions { progress, backend, compute: on.compute.clone(), ..Default::default() };
-    let fitted = match fit_and_keep(None, held, options)? {
+    let (fitted, metrics) = match fit_and_keep(None, held, options)? {
         (FitOutcome::Stopped(step), _) if experiments::interrupt::requested() => {
             return Ok(RunEnd::Interrupted(Some(step)));
         }
@@ -188,12 +188,14 @@ fn fit_evaluate_export(held: &HeldRun, progress: bool, on: &RunOn) -> Result<Run
         // The grace period after the signal is too short for an evaluation: the next start
         // evaluates the weights just written.
         _ if experiments::interrupt::requested() => return Ok(RunEnd::Interrupted(None)),
-        (_, Some(trained)) => trained.into_fitted(),
-        (_, None) => FittedRun::open_on(held.path(), None, None, backend)?,
+        (FitOutcome::Finished { metrics, .. }, Some(trained)) => (trained.into_fitted(), metrics),
+        (FitOutcome::AlreadyFinished(metrics), _) | (FitOutcome::Finished { metrics, .. }, _) => {
+            (FittedRun::open_on(held.path(), None, None, backend)?, metrics)
+        }
     };
     if !held.is_evaluated() {
         let options = EvalOptions { progress, lpips_weights: on.lpips_weights.clone() };
-        experiments::eval::eval_fitted(&fitted, held, &options, Instant::now())?;
+        experiments::eval::eval_fitted(&fitted, held, metrics, &options, Instant::now())?;
     }
     experiments::portable::write_fitted(held, &fitted)?;
     Ok(RunEnd::Done)

@@ -158,7 +158,8 @@ pub fn eval(
     let start = Instant::now();
     let held = RunDir::new(run).hold("evaluating")?;
     let fitted = FittedRun::open_on(run, scene, cache, backend)?;
-    eval_fitted(&fitted, &held, options, start)
+    let trained = RunMetrics::read(&held.metrics())?;
+    eval_fitted(&fitted, &held, trained, options, start)
 }
 
 /// How a process evaluates, beyond the run's configuration.
@@ -178,14 +179,19 @@ impl Default for EvalOptions {
     }
 }
 
-/// Evaluates an opened (or just trained) run in the directory `run` this process holds;
-/// `start` is when the evaluation began (its wall time is recorded).
+/// Evaluates an opened (or just trained) run in the directory `run` this process holds, whose
+/// training wrote `trained` (its `metrics.json`, handed on by the fit of the same process or
+/// read by [`eval`]); `start` is when the evaluation began (its wall time is recorded). Writes
+/// the probe and `metrics.json` with its test record at the end
+/// ([`HeldRun::write_evaluated`]).
 pub fn eval_fitted(
     fitted: &FittedRun,
     run: &HeldRun,
+    trained: RunMetrics,
     options: &EvalOptions,
     start: Instant,
 ) -> Result<TestMetrics> {
+    let mut all = trained;
     let (config, device, model, dataset) =
         (&fitted.config, &fitted.device, &fitted.model, &fitted.dataset);
     let settings = config.eval.resolve(config.train.profile, &options.lpips_weights);
@@ -214,19 +220,12 @@ pub fn eval_fitted(
     let probe =
         if settings.images { probe::probe_fitted(&brdf, dataset, &samples, &data) } else { None };
     charge(&mut phases.probe);
-    let path = run.metrics();
-    let mut all = RunMetrics::read(&path)?;
     let curve = snapshot_curve(fitted, run, &all.snapshots, (&samples, &data))?;
     charge(&mut phases.curve);
     let analyses = Analyses { rmse: (rmse_cbrt, rmse_samples), reciprocity_rmse, energy, curve };
     let test = test_metrics(scores, lpips_unavailable, analyses, dataset, (start, phases));
     all.test = Some(test.clone());
-    // The probe first, `metrics.json` last: a kill between them leaves a run that evaluates
-    // again.
-    if let Some(p) = &probe {
-        probe::write(&run.probe(), p)?;
-    }
-    all.write(&path)?;
+    run.write_evaluated(probe.as_ref().map(|p| |path: &Path| probe::write(path, p)), &all)?;
     Ok(test)
 }
 
