@@ -53,10 +53,11 @@
 //! | `matmul_precision` | f32 | f32 | f32 |
 //!
 //! `quick` decays once (1e-3 to 1e-4) and stops at the next plateau, with 200 steps of patience at
-//! the floor: the default profile's
-//! rule, sized so that Table 1's 27 runs fit this 2-core machine's hour. `cpu` is the patient
-//! rule the `runtime` profile measures plateaus with (three decays by 4, 0.5 % threshold over
-//! 600 steps). `docs/reproduce.md` gives the measurements that chose these values.
+//! the floor. The default profile (`crates/sweep/profiles/default.toml`) takes its rule with
+//! `smoothing = 3` and 100 steps at the floor, to bring every table within the 90 minutes asked
+//! of a 2-core machine (`benches/README.md` has the times measured on each CPU). `cpu` is the
+//! patient rule the `runtime` profile measures plateaus with (three decays by 4, 0.5 % threshold
+//! over 600 steps). `docs/reproduce.md` gives the measurements that chose these values.
 //! `smoothing = 3` watches the mean of the last 3 validation losses instead of each one: at 1e-3
 //! a metal's loss jitters by 4 to 8 % between validations, against a trend of 2 to 4 % per 300
 //! steps, and the single-loss rule decays on a lucky low as often as on a plateau, so where a
