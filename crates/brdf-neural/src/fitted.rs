@@ -6,11 +6,11 @@
 //! ([`PointRows`]). On a CPU a pass gathers each record's row; on a GPU the rows of every
 //! point live on the device ([`device_table`]) and a pass selects them there, so that a pass
 //! uploads only indices and directions. Training keeps its records there too
-//! ([`device_records`]).
+//! ([`crate::training_inputs`]).
 
 use crate::products::Products;
-use crate::{BrdfBatch, BrdfModel, Error, ModelConfig, RecordTable, Result, Samples, SpatialTable};
-use burn::tensor::{Device, Tensor, TensorData};
+use crate::{BrdfBatch, BrdfModel, Error, ModelConfig, Result, Samples, SpatialTable};
+use burn::tensor::{Device, Tensor};
 
 /// Spatial rows of surface points, row-major `[points, dim]`, and the point of each record.
 #[derive(Clone, Copy, Debug)]
@@ -284,56 +284,6 @@ pub fn device_table(
         return Ok(None);
     }
     Ok(Some(SpatialTable::new(config, points.spatial, device)?))
-}
-
-/// Training records on the device: their direction inputs ([`RecordTable`]), weights
-/// (`E cos theta_l`) and targets (the observations' sRGB values), `[records, 3]` each.
-pub struct DeviceRecords {
-    /// The direction inputs and points.
-    pub table: RecordTable,
-    /// Each record's weight.
-    pub weight: Tensor<2>,
-    /// Each record's target.
-    pub target: Tensor<2>,
-}
-
-/// Largest record table [`device_records`] puts on a GPU, in bytes, weights and targets
-/// included.
-pub const DEVICE_RECORDS_MAX_BYTES: usize = 4 << 30;
-
-/// Every record on `device`, with its weight and target (one RGB triple a record each), when
-/// `on_device` (the trainer's default on a GPU) and the model's spatial rows are there too
-/// (`spatial`, from [`device_table`]): each batch then uploads only its record indices. `None`
-/// otherwise, or past [`DEVICE_RECORDS_MAX_BYTES`].
-pub fn device_records(
-    config: &ModelConfig,
-    records: Records,
-    weight: &[[f32; 3]],
-    target: &[[f32; 3]],
-    spatial: Option<&SpatialTable>,
-    on_device: bool,
-    device: &Device,
-) -> Result<Option<DeviceRecords>> {
-    let n = records.len();
-    if weight.len() != n || target.len() != n {
-        return Err(Error::BatchShape(format!(
-            "{n} records with {} weights and {} targets",
-            weight.len(),
-            target.len()
-        )));
-    }
-    let bytes = RecordTable::bytes(config, n) + n * 6 * 4;
-    if !on_device
-        || (config.spatial_dim > 0 && spatial.is_none())
-        || bytes > DEVICE_RECORDS_MAX_BYTES
-    {
-        return Ok(None);
-    }
-    let table = RecordTable::new(config, records.l, records.v, records.points.point, device)?;
-    let rows = |x: &[[f32; 3]]| {
-        Tensor::<2>::from_data(TensorData::new(x.as_flattened().to_vec(), [n, 3]), device)
-    };
-    Ok(Some(DeviceRecords { table, weight: rows(weight), target: rows(target) }))
 }
 
 /// Rows per pass of [`NeuralSurface`] on a GPU: eight of [`CHUNK`]. The energy analysis then

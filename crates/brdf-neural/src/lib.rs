@@ -37,7 +37,8 @@
 //! [`BrdfBatch::from_owned`], [`BrdfBatch::from_table`], [`BrdfBatch::from_records`]).
 //! A fitted model over surface points is [`fitted`]: its predictions on records, the inputs
 //! kept on the device, and the model as a [`brdf_analytic::SurfaceBrdf`]
-//! ([`fitted::NeuralSurface`]).
+//! ([`fitted::NeuralSurface`]); what a training run keeps on the device is
+//! [`training_inputs::TrainingInputs`].
 //!
 //! # Parameter counts
 //!
@@ -91,6 +92,7 @@ pub mod products;
 pub mod record_table;
 pub mod single_mlp;
 pub mod tensor_brdf;
+pub mod training_inputs;
 
 pub use batch::{BrdfBatch, SPATIAL_LIMIT, Samples, SpatialTable};
 pub use error::{Error, Result};

@@ -305,7 +305,7 @@ fn fit_command(
     let (outcome, trained) =
         crate::train::fit_and_keep(Some(&cfg), &held, options).with_context(context)?;
     // The weights for other tools, as a sweep's run exports them after its evaluation.
-    if let Some(trained) = trained {
+    if let Some(crate::train::Handoff::Trained(trained)) = trained {
         let fitted = trained.into_fitted();
         crate::portable::write_fitted(&held, &fitted).with_context(context)?;
     }

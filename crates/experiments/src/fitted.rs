@@ -6,7 +6,7 @@ use crate::{Error, Result};
 use brdf_neural::BrdfModel;
 use brdf_neural::device::Backend;
 use brdf_neural::device::BackendDevice;
-use burn::tensor::Device;
+use burn::tensor::{Bytes, Device};
 use run_format::config::RunConfig;
 use run_format::run_dir::RunDir;
 use scene::Split;
@@ -23,6 +23,16 @@ pub fn load_weights(config: &RunConfig, run: &RunDir, device: &Device) -> Result
     BrdfModel::init(&config.model, device)?
         .try_load_file(&path)
         .map_err(|e| Error::format(&path, format!("cannot load weights: {e:?}")))
+}
+
+/// The weights' file of `model` (a burnpack container), in memory.
+pub fn weight_pack(model: &BrdfModel) -> Result<Bytes> {
+    use burn::module::Module;
+    model
+        .clone()
+        .into_record()
+        .into_bytes()
+        .map_err(|e| Error::format("weights.bpk", format!("cannot serialise the weights: {e:?}")))
 }
 
 /// A finished run with its model loaded and its scene opened.
@@ -58,14 +68,20 @@ impl FittedRun {
         if let Some(s) = scene {
             config.scene = Some(s.to_path_buf());
         }
+        let cache = run.cache(&config, cache);
+        Self::load(config, cache, &run, backend)
+    }
+
+    /// The finished run `run` of `config` (its cache `cache`, its scene the configured one)
+    /// with its final weights loaded on `backend`'s device.
+    pub fn load(config: RunConfig, cache: PathBuf, run: &RunDir, backend: Backend) -> Result<Self> {
         let scene_dir = config
             .scene
             .clone()
             .ok_or_else(|| Error::config("scene", "no scene directory (pass --scene)"))?;
         let device = backend.device()?;
-        let model = load_weights(&config, &run, &device)?;
+        let model = load_weights(&config, run, &device)?;
         let dataset = SceneDataset::open(&scene_dir)?;
-        let cache = run.cache(&config, cache);
         Ok(Self { config, device, model, dataset, cache })
     }
 

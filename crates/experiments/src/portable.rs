@@ -26,7 +26,7 @@
 //! `conventions` (frames and units, in words).
 
 use crate::data::vertex_features;
-use crate::fitted::FittedRun;
+use crate::fitted::{FittedRun, weight_pack};
 use crate::{Error, Result};
 use burn::tensor::DType;
 use run_format::config::RunConfig;
@@ -47,9 +47,12 @@ struct Entry {
     bytes: Vec<u8>,
 }
 
-/// [`write()`] for a fitted run into its own directory `run`, from its final weights.
+/// [`write()`] for a fitted run into its own directory `run`, from its model in memory (the
+/// same tensors as its final weights' file, which export does not read back).
 pub fn write_fitted(run: &RunDir, fitted: &FittedRun) -> Result<[PathBuf; 2]> {
-    write(run, &run.weights(), &fitted.config, &fitted.dataset, &fitted.cache)
+    let pack = burn_pack::Reader::from_bytes(weight_pack(&fitted.model)?);
+    let tensors = model_tensors(pack, &run.weights())?;
+    write_tensors(run, tensors, &fitted.config, &fitted.dataset, &fitted.cache)
 }
 
 /// Writes `model.safetensors` and `model.json` ([`RunDir::portable_weights`],
@@ -66,7 +69,19 @@ pub fn write(
     scene: &SceneDataset,
     cache: &Path,
 ) -> Result<[PathBuf; 2]> {
-    let mut tensors = model_tensors(weights_bpk)?;
+    let tensors = model_tensors(burn_pack::Reader::from_file(weights_bpk), weights_bpk)?;
+    write_tensors(out, tensors, config, scene, cache)
+}
+
+/// [`write()`] of the model's tensors `tensors` ([`model_tensors`]).
+fn write_tensors(
+    out: &RunDir,
+    mut tensors: BTreeMap<String, Entry>,
+    config: &RunConfig,
+    scene: &SceneDataset,
+    cache: &Path,
+) -> Result<[PathBuf; 2]> {
+    let (st, js) = (out.portable_weights(), out.portable_description());
     let (table, dim) = vertex_features(scene, config, cache)?;
     let vertices = table.len() / dim.max(1);
     tensors.insert(
@@ -88,10 +103,10 @@ pub fn write(
         "kind": config.model.kind.config_name(),
         "paper_name": config.model.kind.paper_name(),
         "model": serde_json::to_value(&config.model)
-            .map_err(|e| Error::format(weights_bpk, format!("model configuration: {e}")))?,
+            .map_err(|e| Error::format(&js, format!("model configuration: {e}")))?,
         "spatial": {
             "kind": serde_json::to_value(config.features.spatial)
-                .map_err(|e| Error::format(weights_bpk, format!("spatial kind: {e}")))?,
+                .map_err(|e| Error::format(&js, format!("spatial kind: {e}")))?,
             "dim": dim,
         },
         "conventions": {
@@ -102,7 +117,6 @@ pub fn write(
             "linear_weights": "[out, in] (PyTorch layout)",
         },
     });
-    let (st, js) = (out.portable_weights(), out.portable_description());
     let json = serde_json::to_string_pretty(&description)
         .map_err(|e| Error::format(&js, e.to_string()))?;
     let weights = safetensors_bytes(&tensors);
@@ -112,11 +126,14 @@ pub fn write(
     Ok([st, js])
 }
 
-/// The model's tensors from a burnpack, renamed and in PyTorch layout.
-fn model_tensors(path: &Path) -> Result<BTreeMap<String, Entry>> {
+/// The model's tensors from a burnpack (`reader`; `path` names it in errors), renamed and in
+/// PyTorch layout.
+fn model_tensors(
+    reader: std::result::Result<burn_pack::Reader, burn_pack::Error>,
+    path: &Path,
+) -> Result<BTreeMap<String, Entry>> {
     let bad = |m: String| Error::format(path, m);
-    let reader = burn_pack::Reader::from_file(path)
-        .map_err(|e| bad(format!("cannot read weights: {e:?}")))?;
+    let reader = reader.map_err(|e| bad(format!("cannot read weights: {e:?}")))?;
     let mut out = BTreeMap::new();
     for t in reader.into_tensors().map_err(|e| bad(format!("cannot read weights: {e:?}")))? {
         let (name, dtype, shape, _, bytes) =

@@ -18,17 +18,16 @@
 
 use crate::checkpoint::{self, CheckpointState};
 use crate::data::{RecordSet, spatial_features, split_validation, validation_pairs};
-use crate::fitted::FittedRun;
-use crate::train_loop::{GPU_LOSS_READS, Loop, LoopEnd, gamma_mse, save_weights};
+use crate::fitted::{FittedRun, weight_pack};
+use crate::train_loop::{GPU_LOSS_READS, Loop, LoopEnd, gamma_mse};
 use crate::{Error, Result};
+use brdf_neural::BrdfModel;
 use brdf_neural::device::{Backend, BackendDevice};
-use brdf_neural::fitted::{DeviceRecords, device_records, device_table};
 use brdf_neural::products::Products;
-use brdf_neural::{BrdfModel, SpatialTable};
+use brdf_neural::training_inputs::TrainingInputs;
 use burn::module::Module;
 use burn::optim::{AdamConfig, ModuleOptimizer};
 use burn::tensor::Device;
-use indicatif::ProgressBar;
 use run_format::ComputeSettings;
 use run_format::config::RunConfig;
 use run_format::held_run::HeldRun;
@@ -53,9 +52,9 @@ pub struct FitOptions {
     pub hook: Option<StepHook>,
     /// The burn backend that trains (`--backend`; default: the CPU backend).
     pub backend: brdf_neural::device::Backend,
-    /// Whether each batch selects its inputs from tables kept on the device: its spatial rows
-    /// ([`brdf_neural::fitted::device_table`]) and its records' directions, weights and targets
-    /// ([`brdf_neural::fitted::device_records`]), so that a step uploads only its record indices;
+    /// Whether each batch selects its inputs from tables kept on the device
+    /// ([`TrainingInputs`]: its spatial rows and its records' directions, weights and targets),
+    /// so that a step uploads only its record indices;
     /// `None`: on GPU backends. The same values either way (tests compare the two on the CPU).
     pub inputs_on_device: Option<bool>,
     /// How the run computes beyond its configuration: the bf16 kernel, and the steps between
@@ -105,6 +104,32 @@ impl Trained {
     pub fn into_fitted(self) -> FittedRun {
         let Trained { config, cache, model, device, scene } = self;
         FittedRun { config, device, model, dataset: scene, cache }
+    }
+}
+
+/// What a fit that ended finished hands to the stages after it: the model in memory when it
+/// trained here, or what it read of a run an earlier process finished.
+pub enum Handoff {
+    /// Trained to the end in this process.
+    Trained(Trained),
+    /// Finished before this fit began: its configuration and cache as the fit read them; the
+    /// weights are on disk.
+    Finished {
+        /// The configuration it trained.
+        config: RunConfig,
+        /// Its cache directory.
+        cache: PathBuf,
+    },
+}
+
+impl Handoff {
+    /// The finished run `run` opened for evaluation, its model on `backend`'s device when it
+    /// is read from disk.
+    pub fn into_fitted(self, run: &RunDir, backend: Backend) -> Result<FittedRun> {
+        match self {
+            Handoff::Trained(trained) => Ok(trained.into_fitted()),
+            Handoff::Finished { config, cache } => FittedRun::load(config, cache, run, backend),
+        }
     }
 }
 
@@ -160,35 +185,29 @@ pub fn fit(config: &RunConfig, run: &Path, options: FitOptions) -> Result<FitOut
     fit_and_keep(Some(config), &held, options).map(|(outcome, _)| outcome)
 }
 
-/// [`fit`] in a run directory this process holds, also handing back the model, its
-/// configuration and its scene when it trained to the end (`None` for a run that was already
-/// finished or was stopped). `config: None` trains the configuration the directory holds (a
+/// [`fit`] in a run directory this process holds, also handing the finished run to the stages
+/// after it ([`Handoff`]: the model, its configuration and its scene when it trained to the
+/// end; the configuration and cache of a run that was already finished; `None` for a run that
+/// was stopped). `config: None` trains the configuration the directory holds (a
 /// sweep's prepared run).
 pub fn fit_and_keep(
     config: Option<&RunConfig>,
     held: &HeldRun,
     options: FitOptions,
-) -> Result<(FitOutcome, Option<Trained>)> {
+) -> Result<(FitOutcome, Option<Handoff>)> {
     let started = std::time::Instant::now();
     let begun = held.begin_training(config, options.cache_dir.as_deref())?;
     if let Some(metrics) = begun.finished {
-        return Ok((FitOutcome::AlreadyFinished(metrics), None));
+        let finished = Handoff::Finished { config: begun.config, cache: begun.cache };
+        return Ok((FitOutcome::AlreadyFinished(metrics), Some(finished)));
     }
     let (config, cache, last_checkpoint) = (&begun.config, begun.cache, begun.checkpoint);
-    let dir = held.dir();
-    let RunData { scene, train: data, val, val_floor } =
-        training_data(config, (&cache, options.compute.lbo_memory_bytes()))?;
-    let t = &config.train;
-
-    let device = options.backend.training_device()?;
-    let (model, mut optim, state) = start(config, last_checkpoint.as_deref(), &data, &device)?;
-    let resumed_from = state.step;
-    if resumed_from > 0 {
-        eprintln!("{}: resuming from the checkpoint at step {resumed_from}", dir.path().display());
-    }
-    // The training steps' products: the run's precision (checked against the backend), and on
-    // a GPU the weight gradients' sum over the batch split into parts (split-K), which the
-    // GPU's matrix-product kernels do not split themselves. Evaluation keeps plain f32.
+    let (dir, t) = (held.dir(), &config.train);
+    // How the steps compute, settled before the data are read, so that a configuration the
+    // backend cannot run fails at once. The training steps' products: the run's precision
+    // (checked against the backend), and on a GPU the weight gradients' sum over the batch
+    // split into parts (split-K), which the GPU's matrix-product kernels do not split
+    // themselves. Evaluation keeps plain f32.
     let products = Products::training(t.matmul_precision, options.backend, t.batch_size)?
         .with_bf16_amx(options.compute.bf16_amx)
         .with_gpu(options.compute.gpu);
@@ -197,10 +216,21 @@ pub fn fit_and_keep(
         eprintln!("{}: warning: {why}", dir.path().display());
     }
     let on_device = options.inputs_on_device.unwrap_or(options.backend.is_gpu());
-    let (spatial, val_spatial, records) = device_inputs(config, (&data, &val), on_device, &device)?;
     let gpu_reads = if options.backend.is_gpu() { GPU_LOSS_READS } else { 1 };
     let loss_reads = options.compute.loss_reads.unwrap_or(gpu_reads).max(1);
-    let bar = progress_bar(options.progress, t.iterations, state.step);
+    let bar = stdx::progress::bar(t.iterations, "steps at most", "train", options.progress);
+
+    let RunData { scene, train: data, val, val_floor } =
+        training_data(config, (&cache, options.compute.lbo_memory_bytes()))?;
+    let device = options.backend.training_device()?;
+    let (model, mut optim, state) = start(config, last_checkpoint.as_deref(), &data, &device)?;
+    let resumed_from = state.step;
+    if resumed_from > 0 {
+        eprintln!("{}: resuming from the checkpoint at step {resumed_from}", dir.path().display());
+    }
+    let records = (data.records(), &data.weight[..], &data.observed_gamma[..]);
+    let inputs = TrainingInputs::new(&config.model, records, val.records(), on_device, &device)?;
+    bar.set_position(state.step);
     let lp = Loop {
         config,
         run: dir,
@@ -208,9 +238,7 @@ pub fn fit_and_keep(
         val: &val,
         device,
         products,
-        spatial,
-        val_spatial,
-        records,
+        inputs,
         bar,
         loss_reads,
         started,
@@ -234,10 +262,11 @@ pub fn fit_and_keep(
     metrics.startup_seconds = lp.startup_seconds.get();
     metrics.val_loss_floor = val_floor;
     // The weights for other tools are export's ([`crate::portable`]), written after evaluation.
-    held.write_trained(&state.curve, |path| save_weights(&model, path), &metrics)?;
+    let weights = weight_pack(&model)?;
+    held.write_trained(&state.curve, &weights, &metrics)?;
     let device = lp.device.inner();
     let trained = Trained { config: config.clone(), cache, model: model.valid(), device, scene };
-    Ok((FitOutcome::Finished { metrics, resumed_from }, Some(trained)))
+    Ok((FitOutcome::Finished { metrics, resumed_from }, Some(Handoff::Trained(trained))))
 }
 
 /// The model, optimiser and loop state training starts from: the seeded initialisation, or
@@ -256,33 +285,6 @@ fn start(
         Some(c) => checkpoint::load(c, model, optim),
         None => Ok((model, optim, CheckpointState::default())),
     }
-}
-
-/// The training and validation records' inputs kept on the device when `on_device`: the
-/// training points' spatial rows, the validation points' (on the inference device), and the
-/// training records with their weights and targets.
-#[allow(clippy::type_complexity)]
-fn device_inputs(
-    config: &RunConfig,
-    (data, val): (&RecordSet, &RecordSet),
-    on_device: bool,
-    device: &Device,
-) -> Result<(Option<SpatialTable>, Option<SpatialTable>, Option<DeviceRecords>)> {
-    let spatial = device_table(&config.model, data.points(), on_device, device)?;
-    let val_on_device = on_device && !val.is_empty();
-    let val_spatial =
-        device_table(&config.model, val.points(), val_on_device, &device.clone().inner())?;
-    let (weight, target) = (&data.weight, &data.observed_gamma);
-    let records = device_records(
-        &config.model,
-        data.records(),
-        weight,
-        target,
-        spatial.as_ref(),
-        on_device,
-        device,
-    )?;
-    Ok((spatial, val_spatial, records))
 }
 
 /// Runs the training loop with a panic in it turned into an error: burn and CubeCL panic when a
@@ -315,13 +317,6 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
         (_, Some(s)) => s.clone(),
         _ => "a panic without a message".into(),
     }
-}
-
-/// The training progress bar over the step budget, at `position` (hidden unless `visible`).
-fn progress_bar(visible: bool, budget: u64, position: u64) -> ProgressBar {
-    let bar = stdx::progress::bar(budget, "steps at most", "train", visible);
-    bar.set_position(position);
-    bar
 }
 
 /// `metrics.json` of a run that finished training.

@@ -12,8 +12,9 @@ use crate::diagnose::{all_finite, diagnose, worst_input};
 use crate::loss::{LossWeights, loss, srgb_oetf};
 use crate::loss_window::{FreshLeaves, LossWindow, ReadStep, StepLoss, WindowStart};
 use crate::{Error, Result};
-use brdf_neural::fitted::{DeviceRecords, predict_on};
+use brdf_neural::fitted::predict_on;
 use brdf_neural::products::Products;
+use brdf_neural::training_inputs::TrainingInputs;
 use brdf_neural::{BrdfBatch, BrdfModel, Reciprocity, Samples, SpatialTable};
 use burn::module::Module;
 use burn::optim::{GradientsParams, ModuleOptimizer};
@@ -55,17 +56,12 @@ pub(crate) struct Loop<'a> {
     /// How the training steps' linear layers compute their products (the run's
     /// `matmul_precision`, the batch split on a GPU); validation runs plain f32.
     pub products: Products,
-    /// On a GPU: the spatial rows of every point, on the device, where each batch selects its
-    /// rows ([`brdf_neural::fitted::device_table`]); `None`: batches gather them on the CPU.
-    pub spatial: Option<SpatialTable>,
-    /// On a GPU: the same rows on the inference device, where validation selects its records'
-    /// rows (validation and training records share their points).
-    pub val_spatial: Option<SpatialTable>,
+    /// On a GPU: the spatial rows of the training and validation points and every training
+    /// record's direction inputs, weights and targets, on the device, where each batch selects
+    /// its rows; `None` parts: batches gather them on the CPU.
+    pub inputs: TrainingInputs,
     /// The progress bar (hidden when not shown).
     pub bar: ProgressBar,
-    /// On a GPU: every record's direction inputs, weights and targets on the device, where each
-    /// batch selects its rows ([`brdf_neural::fitted::device_records`]); `None`: batches gather them on the CPU.
-    pub records: Option<DeviceRecords>,
     /// Steps between host reads of the training loss ([`crate::loss_window`]): 1 on the CPU,
     /// [`GPU_LOSS_READS`] on a GPU.
     pub loss_reads: u64,
@@ -343,8 +339,9 @@ impl Loop<'_> {
     }
 
     /// The batch of the records `indices` (model input, weights, targets), with the swap mask
-    /// drawn from `rng` after the indices: selected on the device from [`DeviceRecords`] when
-    /// the loop has them, else gathered, encoded and uploaded here. The same values either way.
+    /// drawn from `rng` after the indices: selected on the device from the records the loop
+    /// keeps there ([`TrainingInputs::records`]), else gathered, encoded and uploaded here. The
+    /// same values either way.
     fn batch(
         &self,
         indices: &[usize],
@@ -353,7 +350,7 @@ impl Loop<'_> {
     ) -> Result<(BrdfBatch, Tensor<2>, Tensor<2>)> {
         let (c, bs) = (&self.config.model, indices.len());
         let swap = c.angles.reciprocity == Reciprocity::RandomSwap;
-        if let Some(records) = &self.records {
+        if let Some(records) = &self.inputs.records {
             let rows: Vec<u32> = indices.iter().map(|&i| i as u32).collect();
             timer.charge(Phase::Gather);
             let mask = swap.then(|| c.angles.swap_mask(bs, rng));
@@ -361,7 +358,7 @@ impl Loop<'_> {
             let batch = BrdfBatch::from_records(
                 c,
                 &records.table,
-                self.spatial.as_ref(),
+                self.inputs.spatial.as_ref(),
                 &index,
                 &self.device,
             )?;
@@ -370,14 +367,14 @@ impl Loop<'_> {
             timer.charge(Phase::Encode);
             return Ok((batch, weight, target));
         }
-        let cpu = match &self.spatial {
+        let cpu = match &self.inputs.spatial {
             Some(_) => self.data.gather_fields(indices),
             None => self.data.gather(indices),
         };
         timer.charge(Phase::Gather);
         let mask = swap.then(|| c.angles.swap_mask(bs, rng));
         let (l, v, mask) = (&cpu.l, &cpu.v, mask.as_deref());
-        let batch = match &self.spatial {
+        let batch = match &self.inputs.spatial {
             Some(table) => {
                 let points = self.data.points_of(indices);
                 BrdfBatch::from_table(c, table, &points, l, v, mask, &self.device)?
@@ -404,7 +401,7 @@ impl Loop<'_> {
         // In f32 even when the steps run bf16 products (the evaluation's batches are plain f32):
         // the plateau rule compares these losses.
         let inference = self.device.clone().inner();
-        let table = self.val_spatial.as_ref();
+        let table = self.inputs.val_spatial.as_ref();
         let v = validation_loss(model, self.config, self.val, table, &inference)?;
         match state.plateau.update(state.step, v, t) {
             Decision::Stop => state.stopped = Some(StopReason::Plateau),
@@ -489,12 +486,8 @@ fn apply_hook(hook: &mut StepHook, step: u64, model: BrdfModel) -> BrdfModel {
     hook(step, model).map(&mut FreshLeaves)
 }
 
-/// Writes weights atomically (a temporary sibling with the same extension, then rename).
+/// Writes weights atomically (a temporary sibling, then rename).
 pub fn save_weights(model: &BrdfModel, path: &Path) -> Result<()> {
-    stdx::fs::write_atomic_with(path, |tmp| {
-        model
-            .clone()
-            .save_file(tmp)
-            .map_err(|e| Error::format(tmp, format!("cannot write weights: {e:?}")))
-    })
+    let pack = crate::fitted::weight_pack(model)?;
+    Ok(stdx::fs::write_atomic(path, &pack)?)
 }

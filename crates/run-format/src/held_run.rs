@@ -8,7 +8,7 @@
 //! trainer's (`experiments::checkpoint`).
 
 use crate::config::RunConfig;
-use crate::run_dir::{CurveRow, RunDir, RunMetrics, write_curve};
+use crate::run_dir::{CurveRow, RunDir, RunMetrics, curve_csv};
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -89,17 +89,20 @@ impl HeldRun {
     /// resumable: the curve of the last checkpoint again (a kill between that checkpoint and
     /// its curve leaves the previous one's, and a run resumed from its last checkpoint trains
     /// no further step that would write it: the kill torture found such a run), the weights
-    /// (`write_weights` writes them, atomically, to the path it is given), and last
-    /// `metrics.json`, so that a kill before it redoes them all.
-    pub fn write_trained<E: From<Error>>(
+    /// (`weights`: the bytes of their file), and last `metrics.json`, so that a kill before it
+    /// redoes them all. Each file is written atomically, and all of them are serialised before
+    /// the first is written.
+    pub fn write_trained(
         &self,
         curve: &[CurveRow],
-        write_weights: impl FnOnce(&Path) -> std::result::Result<(), E>,
+        weights: &[u8],
         metrics: &RunMetrics,
-    ) -> std::result::Result<(), E> {
-        write_curve(&self.dir.curve(), curve)?;
-        write_weights(&self.dir.weights())?;
-        metrics.write(&self.dir.metrics())?;
+    ) -> Result<()> {
+        let metrics_path = self.dir.metrics();
+        let (curve, metrics) = (curve_csv(curve), metrics.to_json(&metrics_path)?);
+        stdx::fs::write_atomic(&self.dir.curve(), curve.as_bytes())?;
+        stdx::fs::write_atomic(&self.dir.weights(), weights)?;
+        stdx::fs::write_atomic(&metrics_path, metrics.as_bytes())?;
         Ok(())
     }
 }

@@ -310,12 +310,17 @@ pub struct CurveRow {
 /// Writes the curve as CSV: `step,loss,val_loss,lr,wall_seconds` (`val_loss` empty where it
 /// was not measured).
 pub fn write_curve(path: &Path, rows: &[CurveRow]) -> Result<()> {
+    Ok(stdx::fs::write_atomic(path, curve_csv(rows).as_bytes())?)
+}
+
+/// The text [`write_curve`] writes.
+pub fn curve_csv(rows: &[CurveRow]) -> String {
     let mut s = String::from("step,loss,val_loss,lr,wall_seconds\n");
     for r in rows {
         let val = r.val_loss.map_or(String::new(), |v| format!("{v:e}"));
         s.push_str(&format!("{},{:e},{val},{:e},{:.3}\n", r.step, r.loss, r.lr, r.seconds));
     }
-    Ok(stdx::fs::write_atomic(path, s.as_bytes())?)
+    s
 }
 
 /// A kept snapshot of the weights (`snapshots/step-NNNNNNNNN.bpk`), for the run-time curve.
@@ -395,8 +400,12 @@ impl RunMetrics {
 
     /// Writes `metrics.json` atomically.
     pub fn write(&self, path: &Path) -> Result<()> {
-        let text =
-            serde_json::to_string_pretty(self).map_err(|e| Error::format(path, e.to_string()))?;
-        Ok(stdx::fs::write_atomic(path, text.as_bytes())?)
+        let json = self.to_json(path)?;
+        Ok(stdx::fs::write_atomic(path, json.as_bytes())?)
+    }
+
+    /// The text [`RunMetrics::write`] writes to `path` (named in the error).
+    pub fn to_json(&self, path: &Path) -> Result<String> {
+        serde_json::to_string_pretty(self).map_err(|e| Error::format(path, e.to_string()))
     }
 }

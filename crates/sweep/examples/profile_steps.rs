@@ -144,7 +144,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         let held = RunDir::new(&run).hold("training, evaluating")?;
         let (outcome, trained) = fit_and_keep(Some(&config), &held, options())?;
-        let trained = trained.ok_or_else(|| format!("{kind}: did not train ({outcome:?})"))?;
+        let Some(experiments::train::Handoff::Trained(trained)) = trained else {
+            return Err(format!("{kind}: did not train ({outcome:?})").into());
+        };
         let metrics = run_format::RunMetrics::read(&RunDir::new(&run).metrics())?;
         let phases = metrics.phases.clone().unwrap_or_default();
         let cells: Vec<String> =

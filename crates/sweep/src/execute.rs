@@ -15,7 +15,6 @@ use super::timing::SweepTiming;
 use brdf_neural::device::Backend;
 use dataset_merl::generate_scene;
 use experiments::eval::EvalOptions;
-use experiments::fitted::FittedRun;
 use experiments::train::fit_and_keep;
 use experiments::{Error, FitOptions, FitOutcome, Result};
 use indicatif::ProgressBar;
@@ -188,9 +187,9 @@ fn fit_evaluate_export(held: &HeldRun, progress: bool, on: &RunOn) -> Result<Run
         // The grace period after the signal is too short for an evaluation: the next start
         // evaluates the weights just written.
         _ if experiments::interrupt::requested() => return Ok(RunEnd::Interrupted(None)),
-        (FitOutcome::Finished { metrics, .. }, Some(trained)) => (trained.into_fitted(), metrics),
-        (FitOutcome::AlreadyFinished(metrics), _) | (FitOutcome::Finished { metrics, .. }, _) => {
-            (FittedRun::open_on(held.path(), None, None, backend)?, metrics)
+        (FitOutcome::AlreadyFinished(metrics) | FitOutcome::Finished { metrics, .. }, handoff) => {
+            let handoff = handoff.ok_or_else(|| Error::format(held.path(), "no trained model"))?;
+            (handoff.into_fitted(held.dir(), backend)?, metrics)
         }
     };
     if !held.is_evaluated() {
