@@ -109,6 +109,7 @@ impl Trained {
 
 /// What a fit that ended finished hands to the stages after it: the model in memory when it
 /// trained here, or what it read of a run an earlier process finished.
+#[allow(clippy::large_enum_variant)] // one per run, moved once
 pub enum Handoff {
     /// Trained to the end in this process.
     Trained(Trained),
