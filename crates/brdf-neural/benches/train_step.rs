@@ -26,7 +26,7 @@
 //!   comparison under bf16 autocast, and the flex products themselves in both precisions;
 //! - `BRDF_BENCH_SPLIT=1,64` times every step with its linear layers' batch split into these
 //!   numbers of parts ([`brdf_neural::batch_split`]; default: what the trainer uses, 1 on the
-//!   CPU and [`brdf_neural::batch_split::gpu_parts`] on a GPU), and, on a GPU backend, prints
+//!   CPU and [`brdf_neural::products::gpu_parts`] on a GPU), and, on a GPU backend, prints
 //!   the times of one 128-wide layer's three products alone (forward, input gradient, weight
 //!   gradient plain and split).
 //!
@@ -38,7 +38,6 @@
 //!
 //! Dated figures, the first (2026-11-21, 2-core AMD EPYC) included, are in benches/README.md.
 
-use brdf_neural::batch_split;
 use brdf_neural::device::Backend;
 use brdf_neural::device::BackendDevice;
 use brdf_neural::gpu_linear::{GpuLinear, GpuTuning};
@@ -521,7 +520,7 @@ fn splits(backend: Backend, n: usize) -> Vec<usize> {
 
 /// The split the trainer uses on `backend` for a batch of `n`.
 fn default_split(backend: Backend, n: usize) -> usize {
-    if backend.is_gpu() { batch_split::gpu_parts(n) } else { 1 }
+    if backend.is_gpu() { brdf_neural::products::gpu_parts(n) } else { 1 }
 }
 
 /// Prints the times of one 128-wide layer's products at batch `n` on `backend` (a GPU):

@@ -18,7 +18,7 @@
 //!
 //! The split is part of the batch's [`Products`], like the precision; the default (1 part)
 //! is the plain product, which keeps the CPU fits bit-identical to before. A training loop on
-//! a GPU asks for [`gpu_parts`] ([`Products::training`]).
+//! a GPU asks for [`crate::products::gpu_parts`] ([`Products::training`]).
 
 use crate::products::Products;
 use burn::nn::Linear;
@@ -26,13 +26,6 @@ use burn::tensor::Tensor;
 
 /// The fewest rows a part may have; smaller parts would make the sum over the parts the cost.
 pub const MIN_ROWS: usize = 256;
-
-/// The split a GPU training loop uses for a batch of `rows`: parts of 512 rows (64 parts at
-/// 2^15), at most 64 parts, and 1 where that does not divide the batch.
-pub fn gpu_parts(rows: usize) -> usize {
-    let parts = (rows / 512).clamp(1, 64);
-    if rows.is_multiple_of(parts) { parts } else { 1 }
-}
 
 /// `layer` applied to `x` (`[rows, d_in]` to `[rows, d_out]`), split into
 /// [`Products::parts`]; unsplit, through [`crate::linear_op::linear`] with `products`.
@@ -65,16 +58,6 @@ mod tests {
     use super::*;
     use burn::nn::LinearConfig;
     use burn::tensor::{Distribution, Tolerance};
-
-    #[test]
-    fn gpu_parts_divide_the_batch_into_parts_of_512_rows() {
-        assert_eq!(gpu_parts(32_768), 64);
-        assert_eq!(gpu_parts(8_192), 16);
-        assert_eq!(gpu_parts(65_536), 64);
-        assert_eq!(gpu_parts(300), 1);
-        assert_eq!(gpu_parts(1_536), 3);
-        assert_eq!(gpu_parts(1_600), 1); // 3 parts do not divide 1,600 rows
-    }
 
     #[test]
     fn split_layers_give_the_plain_values_and_gradients() {

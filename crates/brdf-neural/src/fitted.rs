@@ -172,7 +172,7 @@ fn forward_padded(
     } else {
         (padded(samples.l).into(), padded(samples.v).into())
     };
-    // On a GPU, the training loop's parts of 512 rows (`batch_split::gpu_parts`): every pass of
+    // On a GPU, the training loop's parts of 512 rows (`products::gpu_parts`): every pass of
     // an evaluation then meets the matrix-product shapes that training tuned.
     let products = Products::inference(!crate::device::is_cpu_device(device), padded_n);
     let batch = match source {

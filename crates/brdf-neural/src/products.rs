@@ -10,10 +10,16 @@
 //! a GPU, the batch split of [`crate::batch_split`]. An evaluation on a GPU splits its passes
 //! the same way ([`Products::inference`]), so that it meets the shapes training tuned.
 
-use crate::batch_split::gpu_parts;
 use crate::device::Backend;
 use crate::gpu_linear::{GpuLinear, GpuTuning};
 use crate::precision::{MatmulPrecision, PrecisionSupport};
+
+/// The split a GPU training loop uses for a batch of `rows` ([`crate::batch_split`]): parts of
+/// 512 rows (64 parts at 2^15), at most 64 parts, and 1 where that does not divide the batch.
+pub fn gpu_parts(rows: usize) -> usize {
+    let parts = (rows / 512).clamp(1, 64);
+    if rows.is_multiple_of(parts) { parts } else { 1 }
+}
 
 /// The precision and the batch split of a batch's linear layers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -138,6 +144,16 @@ impl Products {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn gpu_parts_divide_the_batch_into_parts_of_512_rows() {
+        assert_eq!(gpu_parts(32_768), 64);
+        assert_eq!(gpu_parts(8_192), 16);
+        assert_eq!(gpu_parts(65_536), 64);
+        assert_eq!(gpu_parts(300), 1);
+        assert_eq!(gpu_parts(1_536), 3);
+        assert_eq!(gpu_parts(1_600), 1); // 3 parts do not divide 1,600 rows
+    }
 
     #[test]
     fn training_splits_only_on_a_gpu_and_checks_the_precision() {
