@@ -1,6 +1,9 @@
-//! Checkpoints: model weights and Adam state (burnpack, through burn's records, which keep
-//! the parameter ids the optimizer state is keyed by), plus the step, the curve so far and the
-//! elapsed time. The batch RNG needs no state: step `s` draws from a generator seeded with
+//! What training writes as it goes ([`save`]): checkpoints and the weights' snapshots.
+//!
+//! A checkpoint holds the model weights and Adam state (burnpack, through burn's records, which
+//! keep the parameter ids the optimizer state is keyed by), plus the step, the curve so far and
+//! the elapsed time. A snapshot (for evaluation's curve of test scores) is the same weights'
+//! bytes in `<run>/snapshots/`. The batch RNG needs no state: step `s` draws from a generator seeded with
 //! `seed + s`, so a resumed run is identical to an uninterrupted one.
 //!
 //! A checkpoint is written into a temporary folder and renamed into place; older checkpoints
@@ -12,7 +15,7 @@ use crate::{Error, Result};
 use brdf_neural::BrdfModel;
 use burn::module::Module;
 use burn::optim::ModuleOptimizer;
-use run_format::run_dir::{CurveRow, RunDir};
+use run_format::run_dir::{CurveRow, RunDir, write_curve};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -43,27 +46,57 @@ pub struct CheckpointState {
     pub phases: run_format::phases::StepPhases,
 }
 
-/// Writes a checkpoint atomically and removes the older ones; returns its folder.
+/// What training writes after a step: a snapshot of the weights, a checkpoint, or both.
+#[derive(Clone, Copy, Debug)]
+pub struct Writes {
+    /// The weights' snapshot of this step (`<run>/snapshots/`).
+    pub snapshot: bool,
+    /// A checkpoint of this step, with the curve so far.
+    pub checkpoint: bool,
+}
+
+/// Writes what `writes` asks for after `state.step` steps, everything serialised before the
+/// first file is written: the snapshot (the same bytes as the checkpoint's weights), then the
+/// checkpoint (atomically, the older ones removed after it) and the curve. Returns the
+/// checkpoint's folder when one was written.
 pub fn save(
     run: &RunDir,
-    model: &BrdfModel,
-    optim: &ModuleOptimizer,
+    (model, optim): (&BrdfModel, &ModuleOptimizer),
     state: &CheckpointState,
-) -> Result<PathBuf> {
+    writes: Writes,
+) -> Result<Option<PathBuf>> {
+    let weights = crate::fitted::weight_pack(model)?;
+    let checkpoint = match writes.checkpoint {
+        true => Some(serialise(optim, state, &run.checkpoint(state.step))?),
+        false => None,
+    };
+    if writes.snapshot {
+        stdx::fs::write_atomic(&run.snapshot(state.step), &weights)?;
+    }
+    let Some((adam, json)) = checkpoint else { return Ok(None) };
     let dir = run.checkpoint(state.step);
     stdx::fs::write_dir_atomic(&dir, &[], |tmp| -> Result<()> {
-        model
-            .clone()
-            .save_file(tmp.join(MODEL))
-            .map_err(|e| Error::format(tmp.join(MODEL), format!("cannot write weights: {e:?}")))?;
-        let adam = canonical_optimizer_bytes(optim)
-            .map_err(|e| Error::format(tmp.join(OPTIM), format!("cannot write Adam state: {e}")))?;
-        std::fs::write(tmp.join(OPTIM), adam).map_err(|e| Error::io(tmp.join(OPTIM), e))?;
-        let json = serde_json::to_string(state).map_err(|e| Error::format(tmp, e.to_string()))?;
-        std::fs::write(tmp.join(STATE), json).map_err(|e| Error::io(tmp.join(STATE), e))
+        for (name, bytes) in [(MODEL, &weights[..]), (OPTIM, &adam), (STATE, json.as_bytes())] {
+            std::fs::write(tmp.join(name), bytes).map_err(|e| Error::io(tmp.join(name), e))?;
+        }
+        Ok(())
     })?;
     run.remove_checkpoints_but(state.step)?;
-    Ok(dir)
+    write_curve(&run.curve(), &state.curve)?;
+    Ok(Some(dir))
+}
+
+/// A checkpoint's Adam state and loop state, serialised (`dir` names the checkpoint in errors).
+fn serialise(
+    optim: &ModuleOptimizer,
+    state: &CheckpointState,
+    dir: &Path,
+) -> Result<(Vec<u8>, String)> {
+    let adam = canonical_optimizer_bytes(optim)
+        .map_err(|e| Error::format(dir.join(OPTIM), format!("cannot write Adam state: {e}")))?;
+    let json =
+        serde_json::to_string(state).map_err(|e| Error::format(dir.join(STATE), e.to_string()))?;
+    Ok((adam, json))
 }
 
 /// Adam's state as a burnpack with its tensors in name order. burn lists them in the order of

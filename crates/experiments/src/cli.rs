@@ -15,6 +15,7 @@ use brdf_neural::device::Backend;
 use brdf_neural::precision::{MatmulPrecision, PrecisionSupport};
 use clap::Subcommand;
 use run_format::config::RunConfig;
+use run_format::held_run::RunResults;
 use run_format::run_dir::RunDir;
 use run_format::{ComputeSettings, EnergyEstimator};
 use std::path::{Path, PathBuf};
@@ -306,8 +307,10 @@ fn fit_command(
         crate::train::fit_and_keep(Some(&cfg), &held, options).with_context(context)?;
     // The weights for other tools, as a sweep's run exports them after its evaluation.
     if let Some(crate::train::Handoff::Trained(trained)) = trained {
-        let fitted = trained.into_fitted();
-        crate::portable::write_fitted(&held, &fitted).with_context(context)?;
+        let portable = crate::portable::fitted_files(&trained.into_fitted());
+        let results =
+            RunResults { evaluation: None, portable: Some(portable.with_context(context)?) };
+        held.write_results(&results).with_context(context)?;
     }
     match outcome {
         FitOutcome::AlreadyFinished(m) => {

@@ -9,6 +9,7 @@
 use crate::loss::srgb_oetf;
 use crate::{Error, Result};
 use angles::Frame;
+use mesh_encoding::lbo::block_selection;
 use mesh_encoding::{EigenSettings, LboEncoding, LboEncodingConfig, cached_eigenpairs};
 use rand::SeedableRng;
 use rand::rngs::StdRng;
@@ -413,9 +414,11 @@ pub fn lbo_table(
 }
 
 /// mesh-encoding's configuration of the run's LBO selection (run-format states the selection
-/// as data: its indices).
+/// as data; its indices are mesh-encoding's [`block_selection`]).
 fn encoding_config(features: &FeatureConfig) -> Result<LboEncodingConfig> {
-    Ok(LboEncodingConfig { selection: features.lbo.indices()?, ..LboEncodingConfig::default() })
+    let sel = &features.lbo;
+    let selection = block_selection(sel.first, sel.blocks, sel.block_len, sel.k_max)?;
+    Ok(LboEncodingConfig { selection, ..LboEncodingConfig::default() })
 }
 
 fn eigen_settings(features: &FeatureConfig, memory_budget: Option<u64>) -> EigenSettings {
@@ -457,18 +460,12 @@ mod tests {
     /// mesh-encoding's.
     #[test]
     fn the_run_formats_lbo_defaults_are_the_encodings() {
-        use run_format::config::{DEFAULT_MAX_BASIS_FACTOR, LboSelection};
-        let sel = LboSelection::default();
-        assert_eq!(sel.indices().unwrap(), mesh_encoding::LboEncodingConfig::default().selection);
+        use run_format::config::{DEFAULT_MAX_BASIS_FACTOR, FeatureConfig};
+        let features = FeatureConfig::default();
+        let selection = super::encoding_config(&features).unwrap().selection;
+        assert_eq!(selection, mesh_encoding::LboEncodingConfig::default().selection);
+        assert_eq!(selection.len(), features.lbo.dim());
         assert_eq!(DEFAULT_MAX_BASIS_FACTOR, super::EigenSettings::default().max_basis_factor);
-        for (first, blocks, block_len, k_max) in
-            [(0, 1, 4, 4), (10, 3, 5, 100), (64, 6, 16, 512), (3, 0, 16, 3)]
-        {
-            let sel = LboSelection { first, blocks, block_len, k_max, ..LboSelection::default() };
-            let want =
-                mesh_encoding::lbo::encoding::block_selection(first, blocks, block_len, k_max);
-            assert_eq!(sel.indices().unwrap(), want, "{first} {blocks} {block_len} {k_max}");
-        }
     }
 
     use super::*;

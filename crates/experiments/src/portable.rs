@@ -1,6 +1,7 @@
 //! Weights others can read: a fitted model as `model.safetensors` and `model.json`, written
-//! beside `weights.bpk` by the export that follows a run's evaluation ([`write_fitted`]; the
-//! `fit` command writes them when it finishes; on demand for older runs), so that a
+//! beside `weights.bpk` with the results of a run's evaluation ([`fitted_files`], which the
+//! run's holder writes; the `fit` command writes them when it finishes; [`write()`] on demand
+//! for older runs and bundles), so that a
 //! PyTorch or numpy user can rebuild and evaluate the model without this workspace (the
 //! reference modules ship in the Python package: `neural_brdfs.reference_numpy`,
 //! `neural_brdfs.reference_torch`).
@@ -30,6 +31,7 @@ use crate::fitted::{FittedRun, weight_pack};
 use crate::{Error, Result};
 use burn::tensor::DType;
 use run_format::config::RunConfig;
+use run_format::held_run::PortableFiles;
 use run_format::run_dir::RunDir;
 use scene::SceneDataset;
 use std::collections::BTreeMap;
@@ -47,12 +49,13 @@ struct Entry {
     bytes: Vec<u8>,
 }
 
-/// [`write()`] for a fitted run into its own directory `run`, from its model in memory (the
-/// same tensors as its final weights' file, which export does not read back).
-pub fn write_fitted(run: &RunDir, fitted: &FittedRun) -> Result<[PathBuf; 2]> {
+/// The portable files of a fitted run, serialised from its model in memory (the same tensors
+/// as its final weights' file, which export does not read back); its holder writes them
+/// ([`run_format::held_run::HeldRun::write_results`]).
+pub fn fitted_files(fitted: &FittedRun) -> Result<PortableFiles> {
     let pack = burn_pack::Reader::from_bytes(weight_pack(&fitted.model)?);
-    let tensors = model_tensors(pack, &run.weights())?;
-    write_tensors(run, tensors, &fitted.config, &fitted.dataset, &fitted.cache)
+    let tensors = model_tensors(pack, Path::new("weights.bpk"))?;
+    files(tensors, &fitted.config, &fitted.dataset, &fitted.cache)
 }
 
 /// Writes `model.safetensors` and `model.json` ([`RunDir::portable_weights`],
@@ -70,18 +73,18 @@ pub fn write(
     cache: &Path,
 ) -> Result<[PathBuf; 2]> {
     let tensors = model_tensors(burn_pack::Reader::from_file(weights_bpk), weights_bpk)?;
-    write_tensors(out, tensors, config, scene, cache)
+    Ok(files(tensors, config, scene, cache)?.write_to(out)?)
 }
 
-/// [`write()`] of the model's tensors `tensors` ([`model_tensors`]).
-fn write_tensors(
-    out: &RunDir,
+/// The portable files of the model's tensors `tensors` ([`model_tensors`]) and the scene's
+/// spatial features.
+fn files(
     mut tensors: BTreeMap<String, Entry>,
     config: &RunConfig,
     scene: &SceneDataset,
     cache: &Path,
-) -> Result<[PathBuf; 2]> {
-    let (st, js) = (out.portable_weights(), out.portable_description());
+) -> Result<PortableFiles> {
+    let js = Path::new("model.json");
     let (table, dim) = vertex_features(scene, config, cache)?;
     let vertices = table.len() / dim.max(1);
     tensors.insert(
@@ -103,10 +106,10 @@ fn write_tensors(
         "kind": config.model.kind.config_name(),
         "paper_name": config.model.kind.paper_name(),
         "model": serde_json::to_value(&config.model)
-            .map_err(|e| Error::format(&js, format!("model configuration: {e}")))?,
+            .map_err(|e| Error::format(js, format!("model configuration: {e}")))?,
         "spatial": {
             "kind": serde_json::to_value(config.features.spatial)
-                .map_err(|e| Error::format(&js, format!("spatial kind: {e}")))?,
+                .map_err(|e| Error::format(js, format!("spatial kind: {e}")))?,
             "dim": dim,
         },
         "conventions": {
@@ -117,13 +120,9 @@ fn write_tensors(
             "linear_weights": "[out, in] (PyTorch layout)",
         },
     });
-    let json = serde_json::to_string_pretty(&description)
-        .map_err(|e| Error::format(&js, e.to_string()))?;
-    let weights = safetensors_bytes(&tensors);
-    std::fs::create_dir_all(out.path()).map_err(|e| Error::io(out.path(), e))?;
-    stdx::fs::write_atomic(&st, &weights)?;
-    stdx::fs::write_atomic(&js, (json + "\n").as_bytes())?;
-    Ok([st, js])
+    let json =
+        serde_json::to_string_pretty(&description).map_err(|e| Error::format(js, e.to_string()))?;
+    Ok(PortableFiles { weights: safetensors_bytes(&tensors), description: (json + "\n").into() })
 }
 
 /// The model's tensors from a burnpack (`reader`; `path` names it in errors), renamed and in

@@ -25,8 +25,8 @@ use rand::{Rng, SeedableRng};
 use run_format::config::RunConfig;
 use run_format::phases::{Phase, PhaseTimer};
 use run_format::plateau::{Decision, StopReason};
-use run_format::run_dir::{CurveRow, RunDir, Snapshot, write_curve};
-use std::path::{Path, PathBuf};
+use run_format::run_dir::{CurveRow, RunDir, Snapshot};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// A callback run before each step with the step index and the model (tests use it to inject
@@ -185,9 +185,10 @@ impl Loop<'_> {
         Ok(LoopEnd::Done(Box::new((model, state))))
     }
 
-    /// After a read and its validation: the weight snapshot, the budget's stop and the
-    /// checkpoint (every `checkpoint_every` steps, at a stop and when asked to stop); returns
-    /// whether a stop was asked for (`stop_after` reached, or a signal).
+    /// After a read and its validation: the budget's stop, then the weight snapshot and the
+    /// checkpoint (every `checkpoint_every` steps, at a stop and when asked to stop), written
+    /// together once the weights are checked; returns whether a stop was asked for
+    /// (`stop_after` reached, or a signal).
     fn save_progress(
         &self,
         model: &BrdfModel,
@@ -197,8 +198,8 @@ impl Loop<'_> {
         last_checkpoint: &mut Option<PathBuf>,
     ) -> Result<bool> {
         let t = &self.config.train;
-        if t.snapshots && t.snapshot_steps().contains(&state.step) {
-            self.save_snapshot(model, state.step)?;
+        let snapshot = t.snapshots && t.snapshot_steps().contains(&state.step);
+        if snapshot {
             state.snapshots.push(Snapshot { step: state.step, seconds });
         }
         if state.step >= t.iterations && state.stopped.is_none() {
@@ -206,9 +207,17 @@ impl Loop<'_> {
         }
         let interrupted =
             stop_after.is_some_and(|s| state.step >= s) || crate::interrupt::requested();
-        if state.step.is_multiple_of(t.checkpoint_every) || interrupted || state.stopped.is_some() {
+        let checkpoint =
+            state.step.is_multiple_of(t.checkpoint_every) || interrupted || state.stopped.is_some();
+        if checkpoint {
             state.seconds = seconds;
-            *last_checkpoint = Some(self.checkpoint(model, optim, state, value)?);
+        }
+        if snapshot || checkpoint {
+            self.check_finite(model, state, value)?;
+            let writes = checkpoint::Writes { snapshot, checkpoint };
+            if let Some(dir) = checkpoint::save(self.run, (model, optim), state, writes)? {
+                *last_checkpoint = Some(dir);
+            }
         }
         Ok(interrupted)
     }
@@ -421,32 +430,19 @@ impl Loop<'_> {
         *window = (Instant::now(), state.step);
     }
 
-    /// Writes the weights after `step` steps to the snapshot folder.
-    fn save_snapshot(&self, model: &BrdfModel, step: u64) -> Result<()> {
-        let path = self.run.snapshot(step);
-        save_weights(model, &path)
-    }
-
-    /// Checks the weights, writes a checkpoint and the curve.
-    fn checkpoint(
-        &self,
-        model: &BrdfModel,
-        optim: &ModuleOptimizer,
-        state: &CheckpointState,
-        loss: f32,
-    ) -> Result<PathBuf> {
-        if !all_finite(model) {
-            self.bar.abandon();
-            return Err(Error::NonFinite {
-                step: state.step.saturating_sub(1),
-                loss,
-                diagnosis: diagnose(model),
-                checkpoint: self.run.latest_checkpoint()?,
-            });
+    /// Fails with [`Error::NonFinite`] (naming the last good checkpoint) when a weight is not
+    /// finite: nothing is written of such weights.
+    fn check_finite(&self, model: &BrdfModel, state: &CheckpointState, loss: f32) -> Result<()> {
+        if all_finite(model) {
+            return Ok(());
         }
-        let dir = checkpoint::save(self.run, model, optim, state)?;
-        write_curve(&self.run.curve(), &state.curve)?;
-        Ok(dir)
+        self.bar.abandon();
+        Err(Error::NonFinite {
+            step: state.step.saturating_sub(1),
+            loss,
+            diagnosis: diagnose(model),
+            checkpoint: self.run.latest_checkpoint()?,
+        })
     }
 }
 
@@ -484,10 +480,4 @@ pub fn gamma_mse(records: &RecordSet, f: &[[f32; 3]]) -> f64 {
 /// the next step (inside a loss window) gets them as leaves again.
 fn apply_hook(hook: &mut StepHook, step: u64, model: BrdfModel) -> BrdfModel {
     hook(step, model).map(&mut FreshLeaves)
-}
-
-/// Writes weights atomically (a temporary sibling, then rename).
-pub fn save_weights(model: &BrdfModel, path: &Path) -> Result<()> {
-    let pack = crate::fitted::weight_pack(model)?;
-    Ok(stdx::fs::write_atomic(path, &pack)?)
 }

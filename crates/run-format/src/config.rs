@@ -79,8 +79,9 @@ pub struct FeatureConfig {
     pub cache_dir: Option<PathBuf>,
 }
 
-/// The LBO index selection: `0..first`, then `blocks` blocks of `block_len` spread up to
-/// `k_max` (spec 5.2; defaults 64, 6, 16, 512: 160 features).
+/// The LBO index selection, as data: `0..first`, then `blocks` blocks of `block_len` spread up
+/// to `k_max` (spec 5.2; defaults 64, 6, 16, 512: 160 features). The indices it stands for
+/// are mesh-encoding's `block_selection`, which the data step calls.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct LboSelection {
@@ -114,35 +115,13 @@ impl Default for LboSelection {
 }
 
 impl LboSelection {
-    /// The eigenfunction indices: `0..first`, then `blocks` blocks of `block_len` whose starts
-    /// are `round(linspace(first, k_max - block_len, blocks))` (numpy's rounding, half to
-    /// even), so the last block ends at `k_max - 1` (validated first). The default gives
-    /// 0..64 and blocks at 64, 150, 237, 323, 410, 496: 160 indices, the last 511.
-    pub fn indices(&self) -> Result<Vec<usize>> {
-        self.validate()?;
-        let mut out: Vec<usize> = (0..self.first).collect();
-        if self.blocks == 0 {
-            return Ok(out);
-        }
-        let (first, last) = (self.first as f64, (self.k_max - self.block_len) as f64);
-        for b in 0..self.blocks {
-            let start = if self.blocks == 1 {
-                first
-            } else {
-                first + (last - first) * b as f64 / (self.blocks - 1) as f64
-            };
-            let start = start.round_ties_even() as usize;
-            out.extend(start..start + self.block_len);
-        }
-        Ok(out)
-    }
-
     /// Feature count.
     pub fn dim(&self) -> usize {
         self.first + self.blocks * self.block_len
     }
 
-    fn validate(&self) -> Result<()> {
+    /// Checks the selection; errors name the key.
+    pub fn validate(&self) -> Result<()> {
         if self.dim() == 0 {
             return Err(Error::config("features.lbo", "selects no eigenfunction"));
         }

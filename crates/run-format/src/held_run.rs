@@ -1,7 +1,9 @@
 //! A run directory held by one process ([`HeldRun`]): its lock taken once for all the stages
 //! that work in it (a sweep's run holds it from training through evaluation and export), the
 //! leftovers of a killed process cleared when it is taken, and the directory's state checked
-//! against the configuration a fit is about to train ([`HeldRun::begin_training`]).
+//! against the configuration a fit is about to train ([`HeldRun::begin_training`]), and the
+//! files the stages hand it, serialised, written in an order that a kill anywhere leaves
+//! resumable ([`HeldRun::write_trained`], [`HeldRun::write_results`]).
 //!
 //! A run directory is held with [`RunDir::hold`]. The checkpoints' folders are named, listed
 //! and removed by [`RunDir`] ([`RunDir::checkpoint_steps`]); what a checkpoint holds is the
@@ -107,19 +109,80 @@ impl HeldRun {
     }
 }
 
-impl HeldRun {
-    /// Writes what marks the run evaluated: the probe first (`write_probe` writes it,
-    /// atomically, to the path it is given; `None`: no probe), `metrics` (with its test
-    /// record) last, so that a kill between them leaves a run that evaluates again.
-    pub fn write_evaluated<E: From<Error>>(
-        &self,
-        write_probe: Option<impl FnOnce(&Path) -> std::result::Result<(), E>>,
-        metrics: &RunMetrics,
-    ) -> std::result::Result<(), E> {
-        if let Some(write) = write_probe {
-            write(&self.dir.probe())?;
+/// A run's evaluation, serialised for its directory: `metrics.json` with its test record and
+/// the probe's bytes (`None`: no probe).
+#[derive(Clone, Debug)]
+pub struct Evaluation {
+    /// The run's metrics with the test record.
+    pub metrics: RunMetrics,
+    /// `probe.bin`'s bytes.
+    pub probe: Option<Vec<u8>>,
+}
+
+/// A fitted model's files for other tools, serialised: `model.safetensors` and `model.json`
+/// ([`RunDir::portable_weights`], [`RunDir::portable_description`]).
+#[derive(Clone, Debug)]
+pub struct PortableFiles {
+    /// `model.safetensors`.
+    pub weights: Vec<u8>,
+    /// `model.json`.
+    pub description: Vec<u8>,
+}
+
+impl PortableFiles {
+    /// Writes both into `dir` (created if needed), each atomically; returns their paths.
+    pub fn write_to(&self, dir: &RunDir) -> Result<[PathBuf; 2]> {
+        std::fs::create_dir_all(dir.path()).map_err(|e| Error::io(dir.path(), e))?;
+        let files = self.files_in(dir);
+        for (path, bytes) in &files {
+            stdx::fs::write_atomic(path, bytes)?;
         }
-        metrics.write(&self.dir.metrics())?;
+        Ok(files.map(|(path, _)| path))
+    }
+
+    /// Its two files in `dir`: their paths and bytes.
+    fn files_in(&self, dir: &RunDir) -> [(PathBuf, &[u8]); 2] {
+        [
+            (dir.portable_weights(), &self.weights[..]),
+            (dir.portable_description(), &self.description[..]),
+        ]
+    }
+}
+
+/// What evaluation and export leave in a run directory, each part absent when it was not
+/// computed (a run evaluated before keeps its evaluation; the `fit` command does not evaluate).
+#[derive(Clone, Debug, Default)]
+pub struct RunResults {
+    /// The evaluation.
+    pub evaluation: Option<Evaluation>,
+    /// The exported model.
+    pub portable: Option<PortableFiles>,
+}
+
+impl HeldRun {
+    /// Writes a run's results in the order a kill anywhere between leaves a run that evaluates
+    /// again: the probe, the portable model, and `metrics.json` (with its test record) last,
+    /// so that a run marked evaluated has its export. Everything is serialised before the first
+    /// file is written, and each file is written atomically.
+    pub fn write_results(&self, results: &RunResults) -> Result<()> {
+        let metrics_path = self.dir.metrics();
+        let metrics = match &results.evaluation {
+            Some(e) => Some(e.metrics.to_json(&metrics_path)?),
+            None => None,
+        };
+        let mut files: Vec<(PathBuf, &[u8])> = Vec::with_capacity(4);
+        if let Some(probe) = results.evaluation.as_ref().and_then(|e| e.probe.as_ref()) {
+            files.push((self.dir.probe(), probe));
+        }
+        if let Some(portable) = &results.portable {
+            files.extend(portable.files_in(&self.dir));
+        }
+        if let Some(metrics) = &metrics {
+            files.push((metrics_path, metrics.as_bytes()));
+        }
+        for (path, bytes) in &files {
+            stdx::fs::write_atomic(path, bytes)?;
+        }
         Ok(())
     }
 }
@@ -143,6 +206,36 @@ mod tests {
         if complete {
             std::fs::write(path.join(CHECKPOINT_STATE), "{}").unwrap();
         }
+    }
+
+    fn results() -> RunResults {
+        let metrics: RunMetrics = serde_json::from_str(
+            r#"{"steps": 1, "final_train_loss": 0.5, "samples_per_second": 1.0,
+                "wall_seconds": 1.0, "train_records": 1, "val_records": 0,
+                "zero_prediction_loss": 1.0, "parameters": 1}"#,
+        )
+        .unwrap();
+        let evaluation = Evaluation { metrics, probe: Some(b"probe".to_vec()) };
+        let portable = PortableFiles { weights: b"st".to_vec(), description: b"{}".to_vec() };
+        RunResults { evaluation: Some(evaluation), portable: Some(portable) }
+    }
+
+    #[test]
+    fn a_run_is_marked_evaluated_only_after_its_export_is_written() {
+        let tmp = test_support::TempDir::new("held-run-results");
+        let dir = RunDir::new(tmp.0.join("run"));
+        let held = dir.hold("evaluating").unwrap();
+        // The export cannot be written (a folder where its weights go): nothing marks the run
+        // evaluated, so the next start evaluates it again.
+        std::fs::create_dir_all(dir.portable_weights().join("in-the-way")).unwrap();
+        assert!(held.write_results(&results()).is_err());
+        assert!(dir.probe().is_file(), "the probe is written first");
+        assert!(!dir.metrics().exists(), "metrics.json is written last");
+        std::fs::remove_dir_all(dir.portable_weights()).unwrap();
+        held.write_results(&results()).unwrap();
+        assert_eq!(std::fs::read(dir.portable_weights()).unwrap(), b"st");
+        assert_eq!(std::fs::read(dir.portable_description()).unwrap(), b"{}");
+        assert_eq!(RunMetrics::read(&dir.metrics()).unwrap().steps, 1);
     }
 
     #[test]

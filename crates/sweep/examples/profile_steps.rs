@@ -36,8 +36,9 @@
 //! the fit to the end of its first step (`RunMetrics::startup_seconds`), the figure of a fit
 //! started in a fresh process once an earlier one has filled the persistent GPU cache.
 
-use experiments::eval::eval_fitted;
+use experiments::eval::evaluate;
 use experiments::train::{FitOptions, fit_and_keep};
+use run_format::held_run::RunResults;
 use run_format::run_dir::{RunDir, SweepLayout};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -163,7 +164,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let fitted = trained.into_fitted();
         for round in 1..=eval_repeat {
             let start = Instant::now();
-            let test = eval_fitted(&fitted, &held, metrics.clone(), &Default::default(), start)?;
+            let evaluation = evaluate(&fitted, &held, metrics.clone(), &Default::default(), start)?;
+            let test = evaluation.metrics.test.clone().ok_or("no test record")?;
+            held.write_results(&RunResults { evaluation: Some(evaluation), portable: None })?;
             let cells: Vec<String> =
                 test.phases.named().iter().map(|(name, s)| format!("{name} {s:.2}")).collect();
             eprintln!(

@@ -20,7 +20,7 @@ use experiments::{Error, FitOptions, FitOutcome, Result};
 use indicatif::ProgressBar;
 use run_format::ComputeSettings;
 use run_format::config::SpatialKind;
-use run_format::held_run::HeldRun;
+use run_format::held_run::{HeldRun, RunResults};
 use run_format::run_dir::{RunDir, SweepLayout};
 use scene::SceneDataset;
 use scene::{MaterialSpec, SceneConfig, SceneSettings};
@@ -192,11 +192,17 @@ fn fit_evaluate_export(held: &HeldRun, progress: bool, on: &RunOn) -> Result<Run
             (handoff.into_fitted(held.dir(), backend)?, metrics)
         }
     };
-    if !held.is_evaluated() {
-        let options = EvalOptions { progress, lpips_weights: on.lpips_weights.clone() };
-        experiments::eval::eval_fitted(&fitted, held, metrics, &options, Instant::now())?;
-    }
-    experiments::portable::write_fitted(held, &fitted)?;
+    // A run evaluated by an earlier start keeps its evaluation; export follows either way, and
+    // both are written together, the evaluation's `metrics.json` last.
+    let evaluation = match held.is_evaluated() {
+        true => None,
+        false => {
+            let options = EvalOptions { progress, lpips_weights: on.lpips_weights.clone() };
+            Some(experiments::eval::evaluate(&fitted, held, metrics, &options, Instant::now())?)
+        }
+    };
+    let portable = Some(experiments::portable::fitted_files(&fitted)?);
+    held.write_results(&RunResults { evaluation, portable })?;
     Ok(RunEnd::Done)
 }
 

@@ -29,7 +29,7 @@ use crate::data::RecordSet;
 use crate::places::Places;
 use brdf_neural::fitted::{NeuralSurface, device_table, predict, predict_on};
 use metrics::rmse::{CubeRootRmse, RmseConfig};
-use run_format::held_run::HeldRun;
+use run_format::held_run::{Evaluation, RunResults};
 use run_format::metric_settings;
 use run_format::phases::EvalPhases;
 use run_format::run_dir::{RunDir, RunMetrics, Snapshot};
@@ -146,8 +146,9 @@ fn snapshot_curve(
     Ok(out)
 }
 
-/// Evaluates the finished run in `run`, holding its lock; `scene` overrides the config's scene
-/// directory.
+/// Evaluates the finished run in `run` and writes its results with its export (as a sweep's
+/// run does: [`crate::portable::fitted_files`]), holding its lock; `scene` overrides the
+/// config's scene directory.
 pub fn eval(
     run: &Path,
     scene: Option<&Path>,
@@ -159,7 +160,11 @@ pub fn eval(
     let held = RunDir::new(run).hold("evaluating")?;
     let fitted = FittedRun::open_on(run, scene, cache, backend)?;
     let trained = RunMetrics::read(&held.metrics())?;
-    eval_fitted(&fitted, &held, trained, options, start)
+    let evaluation = evaluate(&fitted, &held, trained, options, start)?;
+    let test = evaluation.metrics.test.clone();
+    let portable = Some(crate::portable::fitted_files(&fitted)?);
+    held.write_results(&RunResults { evaluation: Some(evaluation), portable })?;
+    test.ok_or_else(|| crate::Error::format(held.metrics(), "evaluation wrote no test record"))
 }
 
 /// How a process evaluates, beyond the run's configuration.
@@ -179,18 +184,19 @@ impl Default for EvalOptions {
     }
 }
 
-/// Evaluates an opened (or just trained) run in the directory `run` this process holds, whose
-/// training wrote `trained` (its `metrics.json`, handed on by the fit of the same process or
-/// read by [`eval`]); `start` is when the evaluation began (its wall time is recorded). Writes
-/// the probe and `metrics.json` with its test record at the end
-/// ([`HeldRun::write_evaluated`]).
-pub fn eval_fitted(
+/// Evaluates an opened (or just trained) run in the directory `run`, whose training wrote
+/// `trained` (its `metrics.json`, handed on by the fit of the same process or read by
+/// [`eval`]); `start` is when the evaluation began (its wall time is recorded). Writes the
+/// test images (when the run's `[eval]` asks for them) and returns the rest for the run's
+/// holder to write ([`run_format::held_run::HeldRun::write_results`]): `metrics.json` with its test record and the
+/// probe.
+pub fn evaluate(
     fitted: &FittedRun,
-    run: &HeldRun,
+    run: &RunDir,
     trained: RunMetrics,
     options: &EvalOptions,
     start: Instant,
-) -> Result<TestMetrics> {
+) -> Result<Evaluation> {
     let mut all = trained;
     let (config, device, model, dataset) =
         (&fitted.config, &fitted.device, &fitted.model, &fitted.dataset);
@@ -224,9 +230,8 @@ pub fn eval_fitted(
     charge(&mut phases.curve);
     let analyses = Analyses { rmse: (rmse_cbrt, rmse_samples), reciprocity_rmse, energy, curve };
     let test = test_metrics(scores, lpips_unavailable, analyses, dataset, (start, phases));
-    all.test = Some(test.clone());
-    run.write_evaluated(probe.as_ref().map(|p| |path: &Path| probe::write(path, p)), &all)?;
-    Ok(test)
+    all.test = Some(test);
+    Ok(Evaluation { metrics: all, probe: probe.as_ref().map(probe::encode) })
 }
 
 /// What evaluation computes beside the images.

@@ -281,9 +281,13 @@ const VERSION: u32 = 1;
 
 /// Writes a probe to `path` (atomically).
 pub fn write(path: &Path, probe: &BrdfProbe) -> Result<()> {
-    let bytes = stdx::cache_file::encode(MAGIC, VERSION, 0, probe);
-    stdx::fs::write_atomic(path, &bytes)?;
+    stdx::fs::write_atomic(path, &encode(probe))?;
     Ok(())
+}
+
+/// The bytes [`write`](fn@write) writes.
+pub fn encode(probe: &BrdfProbe) -> Vec<u8> {
+    stdx::cache_file::encode(MAGIC, VERSION, 0, probe)
 }
 
 /// Reads a probe written by [`write`](fn@write).

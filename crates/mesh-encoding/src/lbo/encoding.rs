@@ -26,7 +26,7 @@ pub struct LboEncodingConfig {
 impl Default for LboEncodingConfig {
     fn default() -> Self {
         LboEncodingConfig {
-            selection: block_selection(64, 6, 16, 512),
+            selection: block_selection(64, 6, 16, 512).expect("the default selection is valid"),
             drop_constant: true,
             rescale: true,
         }
@@ -41,16 +41,28 @@ impl LboEncodingConfig {
 }
 
 /// Indices `0..first` followed by `blocks` blocks of `block_len` whose starts are
-/// `round(linspace(first, k_max - block_len, blocks))`, so the last block ends at `k_max - 1`.
+/// `round(linspace(first, k_max - block_len, blocks))` (numpy's rounding, half to even), so the
+/// last block ends at `k_max - 1`. The default, `(64, 6, 16, 512)`, gives 0..64 and blocks at
+/// 64, 150, 237, 323, 410, 496: 160 indices, the last 511.
 ///
-/// # Panics
-/// If `k_max < first + block_len` while `blocks > 0`.
-pub fn block_selection(first: usize, blocks: usize, block_len: usize, k_max: usize) -> Vec<usize> {
+/// # Errors
+/// [`Error::Lbo`] if `k_max < first + block_len` while `blocks > 0`.
+pub fn block_selection(
+    first: usize,
+    blocks: usize,
+    block_len: usize,
+    k_max: usize,
+) -> Result<Vec<usize>> {
     let mut out: Vec<usize> = (0..first).collect();
     if blocks == 0 {
-        return out;
+        return Ok(out);
     }
-    assert!(k_max >= first + block_len, "k_max {k_max} too small for the blocks");
+    if k_max < first + block_len {
+        return Err(Error::lbo(format!(
+            "k_max {k_max} is smaller than first + block_len = {}",
+            first + block_len
+        )));
+    }
     let last = (k_max - block_len) as f64;
     for b in 0..blocks {
         let start = if blocks == 1 {
@@ -58,11 +70,10 @@ pub fn block_selection(first: usize, blocks: usize, block_len: usize, k_max: usi
         } else {
             first as f64 + (last - first as f64) * b as f64 / (blocks - 1) as f64
         };
-        // numpy rounds half to even; the default starts are never halves.
         let start = start.round_ties_even() as usize;
         out.extend(start..start + block_len);
     }
-    out
+    Ok(out)
 }
 
 /// The per-vertex encoding: `dim` f32 values a vertex, rows in vertex order.
@@ -175,6 +186,19 @@ mod tests {
         assert_eq!(starts, vec![64, 150, 237, 323, 410, 496]);
         assert_eq!(*s.selection.last().unwrap(), 511);
         assert_eq!(s.required_pairs(), 513);
+    }
+
+    #[test]
+    fn block_selection_spreads_its_blocks_to_k_max_and_refuses_too_small_a_k_max() {
+        assert_eq!(block_selection(0, 1, 4, 4).unwrap(), [0, 1, 2, 3]);
+        assert_eq!(block_selection(3, 0, 16, 3).unwrap(), [0, 1, 2], "no blocks: 0..first");
+        let s = block_selection(10, 3, 5, 100).unwrap();
+        let starts: Vec<usize> = s[10..].chunks(5).map(|c| c[0]).collect();
+        assert_eq!(starts, [10, 52, 95], "linspace(10, 95, 3), the last block ending at 99");
+        // (0, 3, 1, 4): the starts are linspace(0, 3, 3) = 0, 1.5, 3.
+        assert_eq!(block_selection(0, 3, 1, 4).unwrap(), [0, 2, 3], "1.5 rounds half to even");
+        let err = block_selection(10, 2, 8, 17).unwrap_err().to_string();
+        assert!(err.contains("k_max 17") && err.contains("18"), "{err}");
     }
 
     #[test]
