@@ -32,9 +32,7 @@ pub const MIN_ROWS: usize = 256;
 pub(crate) fn linear(layer: &Linear, x: Tensor<2>, products: Products) -> Tensor<2> {
     let parts = products.parts;
     let [rows, d_in] = x.dims();
-    // The gpu-kernels split the weight gradients inside their own kernel.
-    let own_kernels = crate::linear_op::uses_gpu_kernels(&x, products.gpu.linear);
-    if parts <= 1 || !rows.is_multiple_of(parts) || rows / parts < MIN_ROWS || own_kernels {
+    if !splits(&x, products) {
         // The weight first: lazily initialised parameters draw their values at their first
         // `val()`, in the order burn's `Linear::forward` reads them.
         let weight = layer.weight.val();
@@ -51,6 +49,27 @@ pub(crate) fn linear(layer: &Linear, x: Tensor<2>, products: Products) -> Tensor
         Some(bias) => y + bias.val().unsqueeze::<2>(),
         None => y,
     }
+}
+
+/// Whether [`linear`] splits `x`'s rows into [`Products::parts`] (see the module docs).
+fn splits(x: &Tensor<2>, products: Products) -> bool {
+    let (parts, rows) = (products.parts, x.dims()[0]);
+    // The gpu-kernels split the weight gradients inside their own kernel.
+    let own_kernels = crate::linear_op::uses_gpu_kernels(x, products.gpu.linear);
+    !(parts <= 1 || !rows.is_multiple_of(parts) || rows / parts < MIN_ROWS || own_kernels)
+}
+
+/// `relu(layer(x))`, a hidden layer: unsplit and with a bias, through
+/// [`crate::linear_op::linear_relu`] (the bias and the ReLU inside the product); otherwise
+/// [`linear`] followed by [`crate::linear_op::relu`]. The same values either way.
+pub(crate) fn linear_relu(layer: &Linear, x: Tensor<2>, products: Products) -> Tensor<2> {
+    if splits(&x, products) || layer.bias.is_none() {
+        return crate::linear_op::relu(linear(layer, x, products));
+    }
+    // The weight first, as in `linear`.
+    let weight = layer.weight.val();
+    let bias = layer.bias.as_ref().map(|b| b.val()).expect("checked above");
+    crate::linear_op::linear_relu(x, weight, bias, products)
 }
 
 #[cfg(test)]

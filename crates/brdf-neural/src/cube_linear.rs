@@ -101,6 +101,24 @@ impl LinearKernels for CubeBackend {
         B::float_add(B::float_matmul(x, weight), row(bias))
     }
 
+    fn kernel_linear_relu(
+        x: FloatTensor<Self>,
+        weight: FloatTensor<Self>,
+        bias: FloatTensor<Self>,
+        products: Products,
+    ) -> FloatTensor<Self> {
+        if let (Some((xt, xm)), Some((_, wm)), Some((_, bm))) =
+            (matrix(x.clone()), matrix(weight.clone()), matrix(row(bias.clone())))
+            && let p = kernel_precision(&xt.client, products.precision)
+            && let Ok(y) =
+                kernels::forward(&xt.client, &xm, &wm, Some(&bm.handle), true, p, tuning(products))
+        {
+            let shape = Shape::new([y.rows as usize, y.cols as usize]);
+            return tensor(&xt, y, shape);
+        }
+        <B as ActivationOps<B>>::relu(B::float_add(B::float_matmul(x, weight), row(bias)))
+    }
+
     fn kernel_linear_no_bias(
         x: FloatTensor<Self>,
         weight: FloatTensor<Self>,

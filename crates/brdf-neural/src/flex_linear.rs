@@ -5,6 +5,7 @@
 //! | product | operands | kernels' path for a hidden layer at batch 2^15 |
 //! | --- | --- | --- |
 //! | forward `y = x W + b` | x [rows, d_in], W [d_in, d_out] | bias fused into the gemm's blocks of rows; bf16 on request |
+//! | forward of a hidden layer `y = relu(x W + b)` | as above | bias and ReLU fused into the gemm's blocks of rows; bf16 on request |
 //! | input gradient `dY Wᵀ` | dY [rows, d_out], Wᵀ a transposed view | gemm; bf16 on request |
 //! | weight gradient `Xᵀ dY` | Xᵀ a transposed view, dY [rows, d_out] | split-k (k = rows); bf16 on request |
 //!
@@ -17,7 +18,7 @@ use burn::backend::Flex;
 use burn::backend::ops::{FloatTensorOps, ModuleOps};
 use burn::tensor::{Bytes, DType, Shape};
 use burn_flex::{FlexTensor, Layout};
-use cpu_kernels::{MatRef, Precision};
+use cpu_kernels::{Epilogue, MatRef, Precision};
 
 /// The matrix view of a 2-D f32 tensor, or `None` when it is not one.
 fn mat(t: &FlexTensor) -> Option<(usize, usize, MatRef)> {
@@ -54,12 +55,13 @@ unsafe fn output(m: usize, n: usize, write: impl FnOnce(*mut f32)) -> FlexTensor
     FlexTensor::new(Bytes::from_elems(buf), Layout::contiguous(shape), DType::F32)
 }
 
-/// `lhs rhs (+ bias)` through the kernels, or `None` when an operand is not an f32 matrix of
-/// matching shape (or the bias is not n contiguous f32 values).
+/// `lhs rhs (+ bias)`, then the ReLU when `relu`, through the kernels, or `None` when an
+/// operand is not an f32 matrix of matching shape (or the bias is not n contiguous f32 values).
 fn product(
     lhs: &FlexTensor,
     rhs: &FlexTensor,
     bias: Option<&FlexTensor>,
+    relu: bool,
     precision: Precision,
 ) -> Option<FlexTensor> {
     let (m, k, a) = mat(lhs)?;
@@ -80,8 +82,9 @@ fn product(
     };
     // SAFETY: `mat` checked the shapes against the tensors' layouts, which flex keeps inside
     // their buffers; `output` hands the kernel m n fresh floats, all of which it writes.
+    let epilogue = Epilogue { bias: bias_values, relu };
     Some(unsafe {
-        output(m, n, |out| cpu_kernels::matmul(m, n, k, a, b, out, bias_values, precision))
+        output(m, n, |out| cpu_kernels::matmul(m, n, k, a, b, out, epilogue, precision))
     })
 }
 
@@ -92,8 +95,22 @@ pub(crate) fn linear(
     bias: Option<FlexTensor>,
     precision: Precision,
 ) -> FlexTensor {
-    product(&x, &weight, bias.as_ref(), precision)
+    product(&x, &weight, bias.as_ref(), false, precision)
         .unwrap_or_else(|| <Flex as ModuleOps<Flex>>::linear(x, weight, bias))
+}
+
+/// `relu(x W + b)`, a hidden layer, with the bias and the ReLU applied inside the product: the
+/// same bits as [`linear`] followed by flex's `relu`, without the ReLU's pass over the output.
+pub(crate) fn linear_relu(
+    x: FlexTensor,
+    weight: FlexTensor,
+    bias: FlexTensor,
+    precision: Precision,
+) -> FlexTensor {
+    product(&x, &weight, Some(&bias), true, precision).unwrap_or_else(|| {
+        let z = <Flex as ModuleOps<Flex>>::linear(x, weight, Some(bias));
+        <Flex as burn::backend::ops::ActivationOps<Flex>>::relu(z)
+    })
 }
 
 /// The input gradient `dY Wᵀ`.
@@ -103,7 +120,7 @@ pub(crate) fn linear_x_backward(
     precision: Precision,
 ) -> FlexTensor {
     let weight_t = Flex::float_swap_dims(weight, 0, 1);
-    product(&output_grad, &weight_t, None, precision)
+    product(&output_grad, &weight_t, None, false, precision)
         .unwrap_or_else(|| Flex::float_matmul(output_grad, weight_t))
 }
 
@@ -114,7 +131,7 @@ pub(crate) fn linear_weight_backward(
     precision: Precision,
 ) -> FlexTensor {
     let x_t = Flex::float_swap_dims(x, 0, 1);
-    product(&x_t, &output_grad, None, precision)
+    product(&x_t, &output_grad, None, false, precision)
         .unwrap_or_else(|| Flex::float_matmul(x_t, output_grad))
 }
 

@@ -43,6 +43,26 @@ pub fn linear(
     burn::tensor::module::linear(x, weight, bias)
 }
 
+/// `relu(x W + b)`, a hidden layer: the same values and gradients as [`linear`] followed by
+/// [`relu`], with the bias and the ReLU applied inside the product on the flex backend (no
+/// pass of its own over the output, whose buffer the backward pass keeps for the mask).
+pub fn linear_relu(
+    x: Tensor<2>,
+    weight: Tensor<2>,
+    bias: Tensor<1>,
+    products: Products,
+) -> Tensor<2> {
+    #[cfg(feature = "flex")]
+    if x.device().inner() == burn::tensor::Device::flex() {
+        return kernels::linear_relu(x, weight, bias, products);
+    }
+    #[cfg(any(feature = "wgpu", feature = "cuda"))]
+    if uses_gpu_kernels(&x, products.gpu.linear) {
+        return kernels::linear_relu(x, weight, bias, products);
+    }
+    relu(linear(x, weight, Some(bias), products))
+}
+
 /// Whether `x` is on a GPU (CubeCL) device whose linear layers run on this workspace's
 /// `gpu-kernels` when a batch's products ask for `linear` ([`crate::gpu_linear`]).
 pub fn uses_gpu_kernels(x: &Tensor<2>, linear: crate::gpu_linear::GpuLinear) -> bool {

@@ -7,9 +7,11 @@
 //! is computed here (two matrix products, no copy), with the same parameter count.
 //!
 //! Every linear layer runs through [`crate::batch_split`], which splits the batch sum of the
-//! weight gradients into parts on GPU backends.
+//! weight gradients into parts on GPU backends. A hidden layer with nothing added before its
+//! ReLU (no skip, no late input) is one fused operation, `relu(x W + b)`
+//! ([`crate::linear_op::linear_relu`]).
 
-use crate::batch_split::linear;
+use crate::batch_split::{linear, linear_relu};
 use crate::linear_op::relu;
 use crate::products::Products;
 use burn::module::Module;
@@ -108,6 +110,11 @@ impl Mlp {
         };
         let mut h = raw.clone();
         for (k, layer) in self.layers.iter().enumerate() {
+            if k < self.hidden_layers && k != self.skip_into && k != self.late_into {
+                // A hidden layer with nothing added before its ReLU: one fused product.
+                h = linear_relu(layer, h, products);
+                continue;
+            }
             let mut z = linear(layer, h, products);
             if k == self.skip_into
                 && let Some(skip) = &self.skip

@@ -1,5 +1,6 @@
 //! The models' linear layers (`brdf_neural::linear_op`, the `cpu-kernels` crate behind a burn
-//! backend extension) with the bias added in the matrix product's store.
+//! backend extension) with the bias added in the matrix product's store, and the hidden layers
+//! with the bias and the ReLU added there (`linear_relu`).
 //!
 //! A layer's value and its gradients must be those of the unfused form, the product followed
 //! by a broadcast add, to the bit: in f32 (the gemm in blocks of rows) also against burn-flex's
@@ -10,7 +11,7 @@
 #![cfg(feature = "flex")]
 
 use brdf_neural::device::{self, Backend};
-use brdf_neural::linear_op::linear;
+use brdf_neural::linear_op::{linear, linear_relu, relu};
 use brdf_neural::precision::MatmulPrecision;
 use brdf_neural::precision::PrecisionSupport;
 use brdf_neural::products::Products;
@@ -124,4 +125,89 @@ fn linear_layer_gradients_equal_the_unfused_gradients_to_the_bit() {
     assert_same_bits(&fused.1, &plain.1, "dL/dx");
     assert_same_bits(&fused.2, &plain.2, "dL/dW");
     assert_same_bits(&fused.3, &plain.3, "dL/db");
+}
+
+/// `linear_relu` and `relu(linear)` as bit patterns, on inputs whose first row is NaN and
+/// whose bias makes some outputs exactly 0 (a column of zero weights with a zero bias).
+fn fused_relu_and_plain((m, k, n): (usize, usize, usize), seed: u64, p: Products) -> [Vec<u32>; 2] {
+    let d = device::cpu();
+    let mut xs = values(m * k, seed);
+    xs[..k].fill(f32::NAN);
+    let mut ws = values(k * n, seed + 1);
+    let mut bs = values(n, seed + 2);
+    for r in 0..k {
+        ws[r * n] = 0.0;
+    }
+    bs[0] = 0.0;
+    let x = Tensor::<2>::from_data(TensorData::new(xs, [m, k]), &d);
+    let w = Tensor::<2>::from_data(TensorData::new(ws, [k, n]), &d);
+    let b = Tensor::<1>::from_data(TensorData::new(bs, [n]), &d);
+    let fused = linear_relu(x.clone(), w.clone(), b.clone(), p);
+    let plain = relu(linear(x, w, Some(b), p));
+    [bits(fused), bits(plain)]
+}
+
+#[test]
+fn hidden_layers_equal_the_layer_then_the_relu_to_the_bit() {
+    let mut precisions = vec![("f32".to_string(), Products::F32)];
+    MatmulPrecision::Bf16.check(Backend::Flex).unwrap();
+    let amx = if MatmulPrecision::bf16_on_amx() { vec![true, false] } else { vec![false] };
+    for amx in amx {
+        let p = Products { precision: MatmulPrecision::Bf16, ..Products::F32 }.with_bf16_amx(amx);
+        precisions.push((format!("bf16 (AMX: {amx})"), p));
+    }
+    for (what, p) in precisions {
+        for (i, &(m, k, n)) in SHAPES.iter().enumerate() {
+            let [fused, plain] = fused_relu_and_plain((m, k, n), 200 + 10 * i as u64, p);
+            assert_same_bits(&fused, &plain, &format!("{what} relu([{m}, {k}] x [{k}, {n}] + b)"));
+            let f: Vec<f32> = fused.iter().map(|b| f32::from_bits(*b)).collect();
+            assert!(f[..n].iter().all(|v| v.is_nan()), "{what}: a NaN row stays NaN");
+            assert!(
+                f[n..].iter().all(|v| *v >= 0.0 && v.to_bits() >> 31 == 0),
+                "{what}: +0 or more"
+            );
+            assert!(f[n..].chunks(n).all(|r| r[0].to_bits() == 0), "{what}: relu(0) is +0");
+        }
+    }
+}
+
+#[test]
+fn hidden_layer_gradients_equal_the_unfused_gradients_to_the_bit() {
+    let d = device::cpu_training();
+    for (m, k, n) in [(1_100, 36, 64), (2_085, 128, 128), (77, 33, 19)] {
+        let r = Tensor::<2>::from_data(TensorData::new(values(m * n, 7), [m, n]), &d);
+        let run = |fused: bool| {
+            let x = Tensor::<2>::from_data(TensorData::new(values(m * k, 1), [m, k]), &d)
+                .require_grad();
+            let w = Tensor::<2>::from_data(TensorData::new(values(k * n, 2), [k, n]), &d)
+                .require_grad();
+            let b = Tensor::<1>::from_data(TensorData::new(values(n, 3), [n]), &d).require_grad();
+            let y = if fused {
+                linear_relu(x.clone(), w.clone(), b.clone(), Products::F32)
+            } else {
+                burn::tensor::activation::relu(
+                    x.clone().matmul(w.clone()) + b.clone().unsqueeze::<2>(),
+                )
+            };
+            // A second layer on top, so the ReLU's output is also the next layer's input.
+            let y2 = linear(
+                y.clone(),
+                w.clone().transpose().slice([0..n, 0..n.min(k)]),
+                None,
+                Products::F32,
+            );
+            let grads = ((y.clone() * r.clone()).sum() + y2.sum()).backward();
+            let g = |t: Tensor<2>| bits(t.grad(&grads).unwrap());
+            let gb = b.grad(&grads).unwrap().into_data().try_to_vec::<f32>().unwrap();
+            (bits(y), g(x), g(w), gb.iter().map(|v| v.to_bits()).collect::<Vec<_>>())
+        };
+        let (fused, plain) = (run(true), run(false));
+        let at = format!("[{m}, {k}] x [{k}, {n}]");
+        let positive = fused.0.iter().filter(|b| f32::from_bits(**b) > 0.0).count();
+        assert!(positive > 0 && positive < fused.0.len(), "{at}: the ReLU cuts some outputs");
+        assert_same_bits(&fused.0, &plain.0, &format!("{at} values"));
+        assert_same_bits(&fused.1, &plain.1, &format!("{at} dL/dx"));
+        assert_same_bits(&fused.2, &plain.2, &format!("{at} dL/dW"));
+        assert_same_bits(&fused.3, &plain.3, &format!("{at} dL/db"));
+    }
 }

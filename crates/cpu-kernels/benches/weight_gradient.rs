@@ -11,7 +11,7 @@
 //! 2^15), whatever the kernels' own choice. Before them, the input gradients `dY Wᵀ` of the
 //! same layers through gemm's own threading against blocks of rows (the kernels' path).
 
-use cpu_kernels::{MatRef, Precision};
+use cpu_kernels::{Epilogue, MatRef, Precision};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::time::Instant;
@@ -41,7 +41,16 @@ fn product(m: usize, n: usize, k: usize, x: &[f32], dy: &[f32], out: &mut [f32],
     // SAFETY: x holds k m floats, dy k n, out m n.
     unsafe {
         if split {
-            cpu_kernels::matmul(m, n, k, lhs, rhs, out.as_mut_ptr(), None, Precision::F32);
+            cpu_kernels::matmul(
+                m,
+                n,
+                k,
+                lhs,
+                rhs,
+                out.as_mut_ptr(),
+                Epilogue::NONE,
+                Precision::F32,
+            );
         } else {
             cpu_kernels::gemm_f32::gemm(m, n, k, lhs, rhs, out.as_mut_ptr());
         }
@@ -124,7 +133,15 @@ fn input_gradients() {
                 cpu_kernels::gemm_f32::gemm(k, m, n, lhs, rhs, a.as_mut_ptr())
             });
             let rows = median_seconds(|| unsafe {
-                cpu_kernels::gemm_f32::gemm_by_rows(k, m, n, lhs, rhs, None, b.as_mut_ptr())
+                cpu_kernels::gemm_f32::gemm_by_rows(
+                    k,
+                    m,
+                    n,
+                    lhs,
+                    rhs,
+                    Epilogue::NONE,
+                    b.as_mut_ptr(),
+                )
             });
             assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()), "same bits");
             println!(

@@ -23,6 +23,7 @@
 //! `amx`), never a process-wide switch. Every task configures the tiles on its own thread and
 //! releases them when it is done.
 
+use crate::Epilogue;
 use crate::bf16dot::MatRef;
 use crate::bf16dot::pair_bits;
 use crate::bf16dot::x86::{PAIR_ORDER, SendPtr, convert_row, pack_b_pair};
@@ -186,13 +187,13 @@ unsafe fn block(
     }
 }
 
-/// out (m x n, row-major) = lhs (m x k) * rhs (k x n) [+ bias, one value per column] with bf16
-/// operands on AMX tiles. The bias is added to each 32 x 32 block as it leaves the tiles
-/// (fused linear layers), the same f32 addition as a separate pass.
+/// out (m x n, row-major) = epilogue(lhs (m x k) * rhs (k x n)) with bf16 operands on AMX
+/// tiles. The epilogue (a bias per column, then a ReLU) is applied to each 32 x 32 block as it
+/// leaves the tiles (fused linear layers), the same f32 operations as a separate pass.
 ///
 /// # Safety
 /// As [`crate::bf16dot::matmul_bf16dot`]; [`amx_available`] must be true; m, n, k > 0;
-/// `bias`, if any, holds n values.
+/// the epilogue's bias, if any, holds n values.
 pub(crate) unsafe fn matmul(
     m: usize,
     n: usize,
@@ -200,17 +201,15 @@ pub(crate) unsafe fn matmul(
     lhs: MatRef,
     rhs: MatRef,
     out: *mut f32,
-    bias: Option<&[f32]>,
+    epilogue: Epilogue,
 ) {
     #[cfg(feature = "rayon")]
     if k >= 2048 && m * n <= k * 16 {
         unsafe { split_k(m, n, k, lhs, rhs, out) };
-        if let Some(b) = bias {
-            unsafe { crate::bf16dot::add_bias_rows(m, n, out, b) };
-        }
+        unsafe { epilogue.apply_rows(m, n, out) };
         return;
     }
-    unsafe { by_rows(m, n, k, lhs, rhs, out, bias) }
+    unsafe { by_rows(m, n, k, lhs, rhs, out, epilogue) }
 }
 
 /// Blocks of 32 rows in parallel, the whole k of a block in one tile loop.
@@ -221,7 +220,7 @@ unsafe fn by_rows(
     lhs: MatRef,
     rhs: MatRef,
     out: *mut f32,
-    bias: Option<&[f32]>,
+    epilogue: Epilogue,
 ) {
     let kp = k.div_ceil(2);
     let kpp = kp.next_multiple_of(KT);
@@ -250,23 +249,27 @@ unsafe fn by_rows(
                 let a = apack.as_ptr();
                 if rows == MB && cols == NB {
                     unsafe { block(a, kpp * 4, b, kpp / KT, c, n * 4, false) };
-                    if let Some(bias) = bias {
-                        unsafe { add_bias_block(c, n, bias.as_ptr().add(j * NB)) };
+                    match epilogue {
+                        Epilogue { bias: Some(bias), relu: false } => unsafe {
+                            add_bias_block(c, n, bias.as_ptr().add(j * NB))
+                        },
+                        Epilogue { relu: true, .. } => {
+                            for r in 0..MB {
+                                // SAFETY: row r of the 32 x 32 block just stored.
+                                let row =
+                                    unsafe { core::slice::from_raw_parts_mut(c.add(r * n), NB) };
+                                epilogue.apply_row(row, j * NB);
+                            }
+                        }
+                        Epilogue { bias: None, relu: false } => {}
                     }
                 } else {
                     unsafe { block(a, kpp * 4, b, kpp / KT, edge.as_mut_ptr(), NB * 4, false) };
                     for r in 0..rows {
                         let src = &edge[r * NB..r * NB + cols];
                         let dst = unsafe { core::slice::from_raw_parts_mut(c.add(r * n), cols) };
-                        match bias {
-                            Some(bias) => {
-                                let bias = &bias[j * NB..j * NB + cols];
-                                for ((d, s), b) in dst.iter_mut().zip(src).zip(bias) {
-                                    *d = s + b;
-                                }
-                            }
-                            None => dst.copy_from_slice(src),
-                        }
+                        dst.copy_from_slice(src);
+                        epilogue.apply_row(dst, j * NB);
                     }
                 }
             }

@@ -17,6 +17,7 @@
 //! column one u32 ("VNNI" layout). Row-contiguous left operands are converted a tile at a time
 //! inside the parallel loop; the others are packed once, in parallel.
 
+use crate::Epilogue;
 use alloc::vec;
 use alloc::vec::Vec;
 
@@ -98,15 +99,15 @@ impl MatRef {
     }
 }
 
-/// out (m x n, row-major, contiguous) = lhs (m x k) * rhs (k x n) [+ bias] with bf16 operands.
-/// Every element of `out` is written (it may start uninitialised). The bias (n values, one per
-/// column, added in f32 after the sum) goes into the AMX kernel's store; the other kernels add
-/// it in one pass afterwards. `amx`: on AMX tiles where [`bf16_amx_available`] finds them,
+/// out (m x n, row-major, contiguous) = epilogue(lhs (m x k) * rhs (k x n)) with bf16
+/// operands. Every element of `out` is written (it may start uninitialised). The epilogue (a
+/// bias per column added in f32 after the sum, then a ReLU) goes into the AMX kernel's store;
+/// the other kernels apply it in one pass afterwards. `amx`: on AMX tiles where [`bf16_amx_available`] finds them,
 /// else (and everywhere without them) on the AVX512-BF16 kernel or emulated.
 ///
 /// # Safety
 /// `lhs` and `rhs` must address valid m x k and k x n matrices, `out` m * n writable floats;
-/// `bias`, if any, holds n values.
+/// the epilogue's bias, if any, holds n values.
 #[allow(clippy::too_many_arguments)]
 pub unsafe fn matmul_bf16dot(
     m: usize,
@@ -115,7 +116,7 @@ pub unsafe fn matmul_bf16dot(
     lhs: MatRef,
     rhs: MatRef,
     out: *mut f32,
-    bias: Option<&[f32]>,
+    epilogue: Epilogue,
     amx: bool,
 ) {
     if m == 0 || n == 0 {
@@ -128,7 +129,7 @@ pub unsafe fn matmul_bf16dot(
         let _ = amx;
         #[cfg(all(target_arch = "x86_64", target_os = "linux"))]
         if amx && crate::amx::amx_available() {
-            unsafe { crate::amx::matmul(m, n, k, lhs, rhs, out, bias) };
+            unsafe { crate::amx::matmul(m, n, k, lhs, rhs, out, epilogue) };
             return;
         }
         #[cfg(target_arch = "x86_64")]
@@ -144,33 +145,7 @@ pub unsafe fn matmul_bf16dot(
             unsafe { emulated(m, n, k, lhs, rhs, core::slice::from_raw_parts_mut(out, m * n)) };
         }
     }
-    if let Some(b) = bias {
-        unsafe { add_bias_rows(m, n, out, b) };
-    }
-}
-
-/// Adds `bias` (n values) to every row of the m x n row-major matrix at `out`, rows in
-/// parallel: the same f32 additions as burn's broadcast add.
-///
-/// # Safety
-/// `out` addresses m * n floats that no one else touches meanwhile; `bias.len() == n`.
-pub(crate) unsafe fn add_bias_rows(m: usize, n: usize, out: *mut f32, bias: &[f32]) {
-    let out = unsafe { core::slice::from_raw_parts_mut(out, m * n) };
-    let add = |rows: &mut [f32]| {
-        for row in rows.chunks_exact_mut(n) {
-            for (x, b) in row.iter_mut().zip(bias) {
-                *x += b;
-            }
-        }
-    };
-    #[cfg(feature = "rayon")]
-    if m * n >= 1 << 17 {
-        use rayon::prelude::*;
-        let rows = (1usize << 14).div_ceil(n).max(1);
-        out.par_chunks_mut(rows * n).for_each(add);
-        return;
-    }
-    add(out);
+    unsafe { epilogue.apply_rows(m, n, out) };
 }
 
 /// The emulated path on row-major operands (what CPUs without AVX512-BF16 run), public so

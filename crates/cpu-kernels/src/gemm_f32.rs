@@ -1,13 +1,14 @@
 //! f32 products through the `gemm` crate, called exactly as burn-flex calls it (the same
 //! strides, parallelism threshold and flags, so the same bits), plus the fused-bias variant.
 //!
-//! [`gemm_by_rows`] adds a linear layer's bias inside the product: the output is computed
-//! in blocks of about 512 KB of rows, each a single-threaded gemm followed by the bias add while
-//! the block is still in L2, the blocks in parallel. burn's default `linear` is the product and
+//! [`gemm_by_rows`] adds a linear layer's bias (and a hidden layer's ReLU, [`Epilogue`]) inside
+//! the product: the output is computed in blocks of about 512 KB of rows, each a
+//! single-threaded gemm followed by the epilogue while the block is still in L2, the blocks in
+//! parallel. burn's default `linear` is the product and
 //! then a broadcast add, one more pass over the output read and written (16 MB each way for a
 //! [32768, 128] activation, a visible share of a bf16 step in a `perf` profile). A row's value
 //! does not depend on the block it falls in (gemm sums every output over the same k blocks), so
-//! the result equals the whole-matrix gemm followed by the add, to the bit.
+//! the result equals the whole-matrix gemm followed by the add (and the ReLU), to the bit.
 //!
 //! Tall products without a bias (the input gradients `dY Wᵀ`, the skip projections) take the
 //! same blocks of rows: each block one single-threaded gemm, so a batch of 2^15 rows at 128
@@ -16,7 +17,7 @@
 //! blocks ran these products at 0.75 to 1.03 of gemm's own time on two threads and 0.83 to
 //! 1.03 on one (`benches/weight_gradient.rs`, which also checks the bits are equal).
 
-use crate::MatRef;
+use crate::{Epilogue, MatRef};
 
 /// m n k from which gemm runs on every thread (burn-flex's threshold).
 const PARALLEL_THRESHOLD: usize = 192 * 192 * 192;
@@ -93,18 +94,18 @@ pub fn row_blocks(m: usize, n: usize) -> usize {
     m.div_ceil(bias_block_rows(n.max(1)))
 }
 
-/// `out = lhs rhs (+ bias)`, in blocks of rows (see the module documentation), each block one
-/// single-threaded gemm, the blocks on every thread.
+/// `out = epilogue(lhs rhs)`, in blocks of rows (see the module documentation), each block
+/// one single-threaded gemm, the blocks on every thread.
 ///
 /// # Safety
-/// As [`crate::matmul`], with `bias.len() == n` if given, and k > 0.
+/// As [`crate::matmul`], with a bias of n values if given, and k > 0.
 pub unsafe fn gemm_by_rows(
     m: usize,
     n: usize,
     k: usize,
     lhs: MatRef,
     rhs: MatRef,
-    bias: Option<&[f32]>,
+    epilogue: Epilogue,
     out: *mut f32,
 ) {
     struct Out(*mut f32);
@@ -122,13 +123,13 @@ pub unsafe fn gemm_by_rows(
         let a = MatRef { ptr: a, ..lhs };
         // SAFETY: the caller's, for this block of rows; the block is written, then read.
         unsafe { gemm_call(rows, n, k, c, a, rhs, gemm::Parallelism::None) };
-        let Some(bias) = bias else { return };
+        if !epilogue.is_some() {
+            return;
+        }
         // SAFETY: the block's rows x n floats, written just above.
         let block = unsafe { core::slice::from_raw_parts_mut(c, rows * n) };
         for row in block.chunks_exact_mut(n) {
-            for (x, b) in row.iter_mut().zip(bias) {
-                *x += b;
-            }
+            epilogue.apply_row(row, 0);
         }
     };
     #[cfg(feature = "rayon")]

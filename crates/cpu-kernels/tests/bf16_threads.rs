@@ -18,7 +18,16 @@ fn weight_gradient(threads: usize, amx: bool, (m, n, k): (usize, usize, usize)) 
     let dst = &mut out;
     // SAFETY: the operands address k x m and k x n floats, `out` m x n.
     pool.install(|| unsafe {
-        cpu_kernels::matmul(m, n, k, lhs, rhs, dst.as_mut_ptr(), None, precision)
+        cpu_kernels::matmul(
+            m,
+            n,
+            k,
+            lhs,
+            rhs,
+            dst.as_mut_ptr(),
+            cpu_kernels::Epilogue::NONE,
+            precision,
+        )
     });
     assert!(out.iter().all(|v| v.is_finite()));
     out

@@ -74,6 +74,16 @@ pub trait LinearKernels: Backend {
         products: Products,
     ) -> FloatTensor<Self>;
 
+    /// `relu(x W + b)`, a hidden layer: the same values as [`LinearKernels::kernel_linear`]
+    /// followed by [`LinearKernels::kernel_relu`].
+    #[fusion(dtype = x, shape = product_shape(x, weight))]
+    fn kernel_linear_relu(
+        x: FloatTensor<Self>,
+        weight: FloatTensor<Self>,
+        bias: FloatTensor<Self>,
+        products: Products,
+    ) -> FloatTensor<Self>;
+
     /// `x W`, a layer without bias.
     #[fusion(dtype = x, shape = product_shape(x, weight))]
     fn kernel_linear_no_bias(
@@ -107,7 +117,8 @@ pub trait LinearKernels: Backend {
     fn kernel_relu(x: FloatTensor<Self>) -> FloatTensor<Self>;
 
     /// The gradient of [`LinearKernels::kernel_relu`] at `x` for the upstream gradient `grad`:
-    /// `grad` where `x > 0` (or NaN), 0 elsewhere.
+    /// `grad` where `x > 0` (or NaN), 0 elsewhere. `x` may be the ReLU's input or its output:
+    /// the two are positive (or NaN) at the same elements.
     #[fusion(dtype = grad, shape = grad)]
     fn kernel_relu_backward(x: FloatTensor<Self>, grad: FloatTensor<Self>) -> FloatTensor<Self>;
 }
@@ -121,6 +132,15 @@ impl LinearKernels for Flex {
         products: Products,
     ) -> FloatTensor<Self> {
         crate::flex_linear::linear(x, weight, Some(bias), kernel_precision(products))
+    }
+
+    fn kernel_linear_relu(
+        x: FloatTensor<Self>,
+        weight: FloatTensor<Self>,
+        bias: FloatTensor<Self>,
+        products: Products,
+    ) -> FloatTensor<Self> {
+        crate::flex_linear::linear_relu(x, weight, bias, kernel_precision(products))
     }
 
     fn kernel_linear_no_bias(
@@ -225,6 +245,32 @@ impl<B: LinearKernels> Backward<B, 2> for LinearNoBiasBackward {
     }
 }
 
+/// The backward pass of [`LinearKernels::kernel_linear_relu`]: the upstream gradient masked
+/// where the layer's output is not positive (the ReLU's backward, on the output the node keeps,
+/// which the next layer also keeps as its input), then [`LinearBackward`]'s three gradients.
+#[derive(Debug)]
+struct LinearReluBackward;
+
+impl<B: LinearKernels> Backward<B, 3> for LinearReluBackward {
+    type State = (LinearState, B::FloatTensorPrimitive);
+
+    fn backward(
+        self,
+        ops: Ops<Self::State, 3>,
+        grads: &mut Gradients,
+        checkpointer: &mut Checkpointer,
+    ) {
+        let [node_x, node_weight, node_bias] = ops.parents;
+        let (state, output) = ops.state;
+        let grad = B::kernel_relu_backward(output, grads.consume::<B>(&ops.node));
+        let ids = [node_x.map(|n| n.id), node_weight.map(|n| n.id)];
+        register_x_and_weight::<B>(ids, state, &grad, grads, checkpointer);
+        if let Some(node) = node_bias {
+            grads.register::<B>(node.id, B::kernel_linear_bias_backward(grad));
+        }
+    }
+}
+
 /// The backward pass of [`LinearKernels::kernel_relu`]: the upstream gradient masked where the
 /// input was not positive.
 #[derive(Debug)]
@@ -273,6 +319,35 @@ impl<B: LinearKernels, C: CheckpointStrategy> LinearKernels for Autodiff<B, C> {
                 let (x, w, b) =
                     (x.into_primitive(), weight.into_primitive(), bias.into_primitive());
                 prep.finish(B::kernel_linear(x, w, b, products))
+            }
+        }
+    }
+
+    fn kernel_linear_relu(
+        x: FloatTensor<Self>,
+        weight: FloatTensor<Self>,
+        bias: FloatTensor<Self>,
+        products: Products,
+    ) -> FloatTensor<Self> {
+        let (x_tracked, weight_tracked) = (x.is_tracked(), weight.is_tracked());
+        match LinearReluBackward
+            .prepare::<C>([x.node(), weight.node(), bias.node()])
+            .compute_bound()
+            .stateful()
+        {
+            OpsKind::Tracked(mut prep) => {
+                let x_state = weight_tracked.then(|| prep.checkpoint(&x));
+                let weight_state = x_tracked.then(|| prep.checkpoint(&weight));
+                let (x, w, b) =
+                    (x.into_primitive(), weight.into_primitive(), bias.into_primitive());
+                let y = B::kernel_linear_relu(x, w, b, products);
+                // The output's buffer is shared, not copied; the next layer keeps it too.
+                prep.finish(((x_state, weight_state, products), y.clone()), y)
+            }
+            OpsKind::UnTracked(prep) => {
+                let (x, w, b) =
+                    (x.into_primitive(), weight.into_primitive(), bias.into_primitive());
+                prep.finish(B::kernel_linear_relu(x, w, b, products))
             }
         }
     }
@@ -342,6 +417,20 @@ impl<B: LinearKernels, C: CheckpointStrategy> LinearKernels for Autodiff<B, C> {
 #[cfg(feature = "flex")]
 pub(super) fn relu(x: Tensor<2>) -> Tensor<2> {
     Tensor::from_dispatch(<Dispatch as LinearKernels>::kernel_relu(x.into_dispatch()))
+}
+
+/// [`super::linear_relu`] through the extension, which burn routes to the backend of the
+/// tensors.
+pub(super) fn linear_relu(
+    x: Tensor<2>,
+    weight: Tensor<2>,
+    bias: Tensor<1>,
+    products: Products,
+) -> Tensor<2> {
+    let (x, weight, bias) = (x.into_dispatch(), weight.into_dispatch(), bias.into_dispatch());
+    Tensor::from_dispatch(<Dispatch as LinearKernels>::kernel_linear_relu(
+        x, weight, bias, products,
+    ))
 }
 
 /// [`super::linear`] through the extension, which burn routes to the backend of the tensors

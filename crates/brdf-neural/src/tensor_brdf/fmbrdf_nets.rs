@@ -26,6 +26,14 @@ impl FixedLinear {
         let bias = self.bias.clone().reshape([n]);
         crate::linear_op::linear(x, self.weight.clone(), Some(bias), products)
     }
+
+    /// `relu(self.forward(x))`, the bias and the ReLU inside the product
+    /// ([`crate::linear_op::linear_relu`]): the same values and gradients.
+    fn forward_relu(&self, x: Tensor<2>, products: Products) -> Tensor<2> {
+        let [_, n] = self.bias.dims();
+        let bias = self.bias.clone().reshape([n]);
+        crate::linear_op::linear_relu(x, self.weight.clone(), bias, products)
+    }
 }
 
 /// The two helper networks.
@@ -146,7 +154,7 @@ impl FmbrdfNets {
         let p = product(mask.clone() * a);
         let q = product(mask * c);
         let z2 = p.select(0, index.clone()) + tan * q.select(0, index) + second.bias.clone();
-        self.lambda[2..].iter().fold(relu(z2), |h, layer| relu(layer.forward(h, products)))
+        self.lambda[2..].iter().fold(relu(z2), |h, layer| layer.forward_relu(h, products))
     }
 
     /// The Smith Lambda of tan(theta) values, every layer a dense product over the rows (the
@@ -167,7 +175,7 @@ impl FmbrdfNets {
             vec![alpha.clone().expand([n, 1]), beta.expand([n, 1]), tan.clone(), tan * alpha],
             1,
         );
-        self.lambda.iter().fold(x, |h, layer| relu(layer.forward(h, products)))
+        self.lambda.iter().fold(x, |h, layer| layer.forward_relu(h, products))
     }
 
     /// The body-reflection intensity I_b.
@@ -182,10 +190,7 @@ impl FmbrdfNets {
         let mut h = relu(geometry + self.body_params.forward(params, products));
         let last = self.body.len() - 1;
         for (k, layer) in self.body.iter().enumerate() {
-            h = layer.forward(h, products);
-            if k < last {
-                h = relu(h);
-            }
+            h = if k < last { layer.forward_relu(h, products) } else { layer.forward(h, products) };
         }
         softplus(h, 1.0)
     }
