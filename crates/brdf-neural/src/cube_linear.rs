@@ -82,6 +82,28 @@ fn row(b: FloatTensor<B>) -> FloatTensor<B> {
     B::float_reshape(b, Shape::new([1, n]))
 }
 
+/// `x W + b`, or `relu(x W + b)` when `relu`, on the kernels (the ReLU in the product's
+/// epilogue), else on burn's own operations.
+fn with_bias(
+    x: FloatTensor<B>,
+    weight: FloatTensor<B>,
+    bias: FloatTensor<B>,
+    relu: bool,
+    products: Products,
+) -> FloatTensor<B> {
+    if let (Some((xt, xm)), Some((_, wm)), Some((_, bm))) =
+        (matrix(x.clone()), matrix(weight.clone()), matrix(row(bias.clone())))
+        && let p = kernel_precision(&xt.client, products.precision)
+        && let Ok(y) =
+            kernels::forward(&xt.client, &xm, &wm, Some(&bm.handle), relu, p, tuning(products))
+    {
+        let shape = Shape::new([y.rows as usize, y.cols as usize]);
+        return tensor(&xt, y, shape);
+    }
+    let y = B::float_add(B::float_matmul(x, weight), row(bias));
+    if relu { <B as ActivationOps<B>>::relu(y) } else { y }
+}
+
 impl LinearKernels for CubeBackend {
     fn kernel_linear(
         x: FloatTensor<Self>,
@@ -89,16 +111,7 @@ impl LinearKernels for CubeBackend {
         bias: FloatTensor<Self>,
         products: Products,
     ) -> FloatTensor<Self> {
-        if let (Some((xt, xm)), Some((_, wm)), Some((_, bm))) =
-            (matrix(x.clone()), matrix(weight.clone()), matrix(row(bias.clone())))
-            && let p = kernel_precision(&xt.client, products.precision)
-            && let Ok(y) =
-                kernels::forward(&xt.client, &xm, &wm, Some(&bm.handle), false, p, tuning(products))
-        {
-            let shape = Shape::new([y.rows as usize, y.cols as usize]);
-            return tensor(&xt, y, shape);
-        }
-        B::float_add(B::float_matmul(x, weight), row(bias))
+        with_bias(x, weight, bias, false, products)
     }
 
     fn kernel_linear_relu(
@@ -107,16 +120,7 @@ impl LinearKernels for CubeBackend {
         bias: FloatTensor<Self>,
         products: Products,
     ) -> FloatTensor<Self> {
-        if let (Some((xt, xm)), Some((_, wm)), Some((_, bm))) =
-            (matrix(x.clone()), matrix(weight.clone()), matrix(row(bias.clone())))
-            && let p = kernel_precision(&xt.client, products.precision)
-            && let Ok(y) =
-                kernels::forward(&xt.client, &xm, &wm, Some(&bm.handle), true, p, tuning(products))
-        {
-            let shape = Shape::new([y.rows as usize, y.cols as usize]);
-            return tensor(&xt, y, shape);
-        }
-        <B as ActivationOps<B>>::relu(B::float_add(B::float_matmul(x, weight), row(bias)))
+        with_bias(x, weight, bias, true, products)
     }
 
     fn kernel_linear_no_bias(

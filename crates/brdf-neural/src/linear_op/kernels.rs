@@ -180,9 +180,9 @@ impl LinearKernels for Flex {
     }
 }
 
-/// The backward pass of one linear layer with a bias ([`LinearBackward`]) or without
-/// ([`LinearNoBiasBackward`]): x and W are checkpointed only where the other one needs a
-/// gradient, as in burn's own `linear`.
+/// The backward pass of one linear layer with a bias ([`LinearBackward`], also for a layer
+/// ending in a ReLU) or without ([`LinearNoBiasBackward`]): x and W are checkpointed only where
+/// the other one needs a gradient, as in burn's own `linear`.
 #[derive(Debug)]
 struct LinearBackward;
 /// See [`LinearBackward`].
@@ -212,7 +212,11 @@ fn register_x_and_weight<B: LinearKernels>(
 }
 
 impl<B: LinearKernels> Backward<B, 3> for LinearBackward {
-    type State = LinearState;
+    /// The layer's x, W and products, and its output when the layer ends in a ReLU
+    /// ([`LinearKernels::kernel_linear_relu`]): the upstream gradient is first masked where
+    /// that output is not positive (the ReLU's backward, on the output the node keeps, which
+    /// the next layer also keeps as its input).
+    type State = (LinearState, Option<B::FloatTensorPrimitive>);
 
     fn backward(
         self,
@@ -221,9 +225,13 @@ impl<B: LinearKernels> Backward<B, 3> for LinearBackward {
         checkpointer: &mut Checkpointer,
     ) {
         let [node_x, node_weight, node_bias] = ops.parents;
-        let grad = grads.consume::<B>(&ops.node);
+        let (state, relu_output) = ops.state;
+        let mut grad = grads.consume::<B>(&ops.node);
+        if let Some(output) = relu_output {
+            grad = B::kernel_relu_backward(output, grad);
+        }
         let ids = [node_x.map(|n| n.id), node_weight.map(|n| n.id)];
-        register_x_and_weight::<B>(ids, ops.state, &grad, grads, checkpointer);
+        register_x_and_weight::<B>(ids, state, &grad, grads, checkpointer);
         if let Some(node) = node_bias {
             grads.register::<B>(node.id, B::kernel_linear_bias_backward(grad));
         }
@@ -242,32 +250,6 @@ impl<B: LinearKernels> Backward<B, 2> for LinearNoBiasBackward {
         let grad = grads.consume::<B>(&ops.node);
         let ids = ops.parents.map(|n| n.map(|n| n.id));
         register_x_and_weight::<B>(ids, ops.state, &grad, grads, checkpointer);
-    }
-}
-
-/// The backward pass of [`LinearKernels::kernel_linear_relu`]: the upstream gradient masked
-/// where the layer's output is not positive (the ReLU's backward, on the output the node keeps,
-/// which the next layer also keeps as its input), then [`LinearBackward`]'s three gradients.
-#[derive(Debug)]
-struct LinearReluBackward;
-
-impl<B: LinearKernels> Backward<B, 3> for LinearReluBackward {
-    type State = (LinearState, B::FloatTensorPrimitive);
-
-    fn backward(
-        self,
-        ops: Ops<Self::State, 3>,
-        grads: &mut Gradients,
-        checkpointer: &mut Checkpointer,
-    ) {
-        let [node_x, node_weight, node_bias] = ops.parents;
-        let (state, output) = ops.state;
-        let grad = B::kernel_relu_backward(output, grads.consume::<B>(&ops.node));
-        let ids = [node_x.map(|n| n.id), node_weight.map(|n| n.id)];
-        register_x_and_weight::<B>(ids, state, &grad, grads, checkpointer);
-        if let Some(node) = node_bias {
-            grads.register::<B>(node.id, B::kernel_linear_bias_backward(grad));
-        }
     }
 }
 
@@ -294,6 +276,41 @@ impl<B: LinearKernels> Backward<B, 1> for ReluBackward {
     }
 }
 
+/// A layer with a bias on the autodiff backend, `x W + b`, or `relu(x W + b)` when `relu`:
+/// one graph node ([`LinearBackward`]) around the inner backend's kernel.
+fn tracked_linear<B: LinearKernels, C: CheckpointStrategy>(
+    x: FloatTensor<Autodiff<B, C>>,
+    weight: FloatTensor<Autodiff<B, C>>,
+    bias: FloatTensor<Autodiff<B, C>>,
+    products: Products,
+    relu: bool,
+) -> FloatTensor<Autodiff<B, C>> {
+    let forward = |x, w, b| match relu {
+        true => B::kernel_linear_relu(x, w, b, products),
+        false => B::kernel_linear(x, w, b, products),
+    };
+    let (x_tracked, weight_tracked) = (x.is_tracked(), weight.is_tracked());
+    match LinearBackward
+        .prepare::<C>([x.node(), weight.node(), bias.node()])
+        .compute_bound()
+        .stateful()
+    {
+        OpsKind::Tracked(mut prep) => {
+            // x is needed only for the weight gradient, W only for the input gradient.
+            let x_state = weight_tracked.then(|| prep.checkpoint(&x));
+            let weight_state = x_tracked.then(|| prep.checkpoint(&weight));
+            let y = forward(x.into_primitive(), weight.into_primitive(), bias.into_primitive());
+            // A ReLU's output is kept for the mask: its buffer is shared, not copied, and the
+            // next layer keeps it too.
+            let kept = relu.then(|| y.clone());
+            prep.finish(((x_state, weight_state, products), kept), y)
+        }
+        OpsKind::UnTracked(prep) => {
+            prep.finish(forward(x.into_primitive(), weight.into_primitive(), bias.into_primitive()))
+        }
+    }
+}
+
 impl<B: LinearKernels, C: CheckpointStrategy> LinearKernels for Autodiff<B, C> {
     fn kernel_linear(
         x: FloatTensor<Self>,
@@ -301,26 +318,7 @@ impl<B: LinearKernels, C: CheckpointStrategy> LinearKernels for Autodiff<B, C> {
         bias: FloatTensor<Self>,
         products: Products,
     ) -> FloatTensor<Self> {
-        let (x_tracked, weight_tracked) = (x.is_tracked(), weight.is_tracked());
-        match LinearBackward
-            .prepare::<C>([x.node(), weight.node(), bias.node()])
-            .compute_bound()
-            .stateful()
-        {
-            OpsKind::Tracked(mut prep) => {
-                // x is needed only for the weight gradient, W only for the input gradient.
-                let x_state = weight_tracked.then(|| prep.checkpoint(&x));
-                let weight_state = x_tracked.then(|| prep.checkpoint(&weight));
-                let (x, w, b) =
-                    (x.into_primitive(), weight.into_primitive(), bias.into_primitive());
-                prep.finish((x_state, weight_state, products), B::kernel_linear(x, w, b, products))
-            }
-            OpsKind::UnTracked(prep) => {
-                let (x, w, b) =
-                    (x.into_primitive(), weight.into_primitive(), bias.into_primitive());
-                prep.finish(B::kernel_linear(x, w, b, products))
-            }
-        }
+        tracked_linear::<B, C>(x, weight, bias, products, false)
     }
 
     fn kernel_linear_relu(
@@ -329,27 +327,7 @@ impl<B: LinearKernels, C: CheckpointStrategy> LinearKernels for Autodiff<B, C> {
         bias: FloatTensor<Self>,
         products: Products,
     ) -> FloatTensor<Self> {
-        let (x_tracked, weight_tracked) = (x.is_tracked(), weight.is_tracked());
-        match LinearReluBackward
-            .prepare::<C>([x.node(), weight.node(), bias.node()])
-            .compute_bound()
-            .stateful()
-        {
-            OpsKind::Tracked(mut prep) => {
-                let x_state = weight_tracked.then(|| prep.checkpoint(&x));
-                let weight_state = x_tracked.then(|| prep.checkpoint(&weight));
-                let (x, w, b) =
-                    (x.into_primitive(), weight.into_primitive(), bias.into_primitive());
-                let y = B::kernel_linear_relu(x, w, b, products);
-                // The output's buffer is shared, not copied; the next layer keeps it too.
-                prep.finish(((x_state, weight_state, products), y.clone()), y)
-            }
-            OpsKind::UnTracked(prep) => {
-                let (x, w, b) =
-                    (x.into_primitive(), weight.into_primitive(), bias.into_primitive());
-                prep.finish(B::kernel_linear_relu(x, w, b, products))
-            }
-        }
+        tracked_linear::<B, C>(x, weight, bias, products, true)
     }
 
     fn kernel_linear_no_bias(
