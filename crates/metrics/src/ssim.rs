@@ -73,8 +73,14 @@ fn reflect(i: i64, n: i64) -> usize {
 ///
 /// Row at a time and tap by tap (the inner loop vectorises over pixels) on a border-extended
 /// line; every output sums its taps in the direct loop's order, so the values are the direct
-/// filter's bit for bit (`filter_equals_direct_loop`).
+/// filter's bit for bit (`filter_equals_direct_loop`), on AVX2's wider vectors where the CPU
+/// has them ([`stdx::simd::with_avx2`]: the same operations, so the same bits).
 fn gaussian_filter(src: &[f64], w: usize, h: usize, k: &[f64]) -> Vec<f64> {
+    stdx::simd::with_avx2(|| gaussian_filter_rows(src, w, h, k))
+}
+
+#[inline(always)]
+fn gaussian_filter_rows(src: &[f64], w: usize, h: usize, k: &[f64]) -> Vec<f64> {
     let r = (k.len() / 2) as i64;
     let mut tmp = vec![0.0; src.len()];
     let mut out = vec![0.0; src.len()];

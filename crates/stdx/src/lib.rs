@@ -7,6 +7,7 @@
 //! - [`rng`]: SplitMix64, the seeded generator behind every reproducible stream that is not a
 //!   `rand` one (orbit cameras, sensor noise, light splits, Lanczos start blocks, Monte Carlo);
 //! - [`progress`]: the progress-bar styles of every long step;
+//! - [`simd`]: loops compiled for AVX2 where the CPU has it, with the baseline build's bits;
 //! - [`cache_file`]: the versioned, checksummed container of every on-disk cache (serde values in
 //!   postcard).
 //!
@@ -24,5 +25,6 @@ pub mod lock;
 #[cfg(feature = "progress")]
 pub mod progress;
 pub mod rng;
+pub mod simd;
 
 pub use limits::Limits;

@@ -46,6 +46,7 @@ use crate::{Error, Result};
 use brdf_neural::fitted::Prediction;
 use indicatif::ProgressBar;
 use metrics::Image;
+use metrics::flip::FlipWindow;
 use metrics::lpips::Lpips;
 use rayon::prelude::*;
 use run_format::ImageMetrics;
@@ -107,11 +108,26 @@ fn to_image(w: usize, h: usize, v: &[[f32; 3]]) -> Result<Image> {
     Ok(Image::new(w, h, v.iter().flat_map(|c| c.iter().copied()).collect())?)
 }
 
+/// A test image in the two spaces the metrics take: linear (HDR-FLIP) and sRGB clamped to
+/// [0, 1] (PSNR, DSSIM, LPIPS), converted once however many comparisons it is in.
+pub struct Shown {
+    /// Linear values.
+    pub linear: Image,
+    /// [`metrics::srgb::to_srgb_clamped`] of them.
+    pub srgb: Image,
+}
+
+impl Shown {
+    fn new(linear: Image) -> Shown {
+        Shown { srgb: metrics::srgb::to_srgb_clamped(&linear), linear }
+    }
+}
+
 /// Scores `test` against `reference` on `mask`; `flip` is HDR-FLIP of the same pair on the
 /// same mask (computed by the caller from prepared images, [`metrics::FlipImage`]).
 pub fn score(
-    test: &Image,
-    reference: &Image,
+    test: &Shown,
+    reference: &Shown,
     mask: &[bool],
     lpips: Option<&Lpips>,
     flip: &metrics::FlipResult,
@@ -119,8 +135,7 @@ pub fn score(
     let lpips = match lpips {
         Some(net) => {
             let masked = |im: &Image| {
-                let srgb = metrics::srgb::to_srgb_clamped(im);
-                let d: Vec<f32> = srgb
+                let d: Vec<f32> = im
                     .data()
                     .chunks_exact(3)
                     .zip(mask)
@@ -128,13 +143,13 @@ pub fn score(
                     .collect();
                 Image::new(im.width(), im.height(), d)
             };
-            Some(net.distance(&masked(test)?, &masked(reference)?)?)
+            Some(net.distance(&masked(&test.srgb)?, &masked(&reference.srgb)?)?)
         }
         None => None,
     };
     Ok(ImageMetrics {
-        psnr: metrics::psnr_linear(test, reference, Some(mask))?,
-        dssim: metrics::dssim_linear(test, reference, Some(mask))?,
+        psnr: metrics::psnr(&test.srgb, &reference.srgb, Some(mask))?,
+        dssim: metrics::dssim(&test.srgb, &reference.srgb, Some(mask))?,
         flip: flip.mean,
         lpips,
     })
@@ -148,15 +163,15 @@ pub fn score(
 /// is the pair's LPIPS, which LPIPS already computes on the whole frame (the background is 0 in
 /// both images here, as in the masked protocol's input).
 pub fn whole_frame(
-    test: &Image,
-    reference: &Image,
+    test: &Shown,
+    reference: &Shown,
     flip: &metrics::flip::FlipResult,
     lpips: Option<f64>,
 ) -> Result<ImageMetrics> {
     let map = &flip.map;
     Ok(ImageMetrics {
-        psnr: metrics::psnr_linear(test, reference, None)?,
-        dssim: metrics::dssim_linear(test, reference, None)?,
+        psnr: metrics::psnr(&test.srgb, &reference.srgb, None)?,
+        dssim: metrics::dssim(&test.srgb, &reference.srgb, None)?,
         flip: map.iter().map(|&v| v as f64).sum::<f64>() / map.len().max(1) as f64,
         lpips,
     })
@@ -252,45 +267,41 @@ fn score_pair(
     let render = |part: &[[f32; 3]]| t.render(records, part);
     let img = render(&pred.f);
     let mask = t.mask(vi);
-    let test = to_image(w, h, &img)?;
-    let observed = to_image(w, h, &dataset.observed_image(vi, li)?)?;
-    // Every comparison of a test image shares the observed image's FLIP exposures (a
-    // noise-free image can be black where every lit pixel faces away), so each of the (up to
-    // four) images is prepared for FLIP once, whichever side of a comparison it is on.
-    let range = metrics::flip::exposure_range(&observed, Some(&mask))?;
-    let at = metrics::FlipExposures::new(range, metrics::flip::DEFAULT_PPD)?;
-    let (flip_test, flip_observed) =
-        (metrics::FlipImage::new(&test, &at)?, metrics::FlipImage::new(&observed, &at)?);
-    let flip = metrics::hdr_flip_prepared(&flip_test, &flip_observed, Some(&mask))?;
-    let model = score(&test, &observed, &mask, opts.lpips, &flip)?;
+    let test = Shown::new(to_image(w, h, &img)?);
+    let observed = Shown::new(to_image(w, h, &dataset.observed_image(vi, li)?)?);
+    // The observation with its background set to 0, scored over the whole frame: the
+    // paper's protocol for a capture, its other reading for a generated scene.
+    let reference = Shown::new(background_removed(&observed.linear, &mask)?);
+    let noise_free =
+        dataset.clean_image(vi, li)?.map(|c| to_image(w, h, &c).map(Shown::new)).transpose()?;
+    let whole_frame_references = [Some(&reference.linear), noise_free.as_ref().map(|n| &n.linear)];
+    let flip = FlipPair::new(&test.linear, &observed.linear, &mask, whole_frame_references)?;
+    let (flip_test, flip_observed) = (flip.prepare(&test.linear)?, flip.prepare(&observed.linear)?);
+    let model_flip = flip.compare(&flip_test, &flip_observed, Some(&mask))?;
+    let model = score(&test, &observed, &mask, opts.lpips, &model_flip)?;
     let mut scores =
         PairScores { model, clean: None, ceiling: None, paper: None, paper_observed: None };
-    // The observation with its background set to 0, scored over the whole frame: the
-    // paper's protocol for a capture, its other reading for a generated scene. The masked
-    // LPIPS blacks out both backgrounds: it is the whole frame's here.
-    let reference = background_removed(&observed, &mask)?;
-    let flip_reference = metrics::FlipImage::new(&reference, &at)?;
-    let f = metrics::hdr_flip_prepared(&flip_test, &flip_reference, None)?;
+    // The masked LPIPS blacks out both backgrounds: it is the whole frame's here.
+    let f = flip.compare(&flip_test, &flip.prepare(&reference.linear)?, None)?;
     let against_observed = whole_frame(&test, &reference, &f, scores.model.lpips)?;
-    if let Some(noise_free) = dataset.clean_image(vi, li)? {
-        let noise_free = to_image(w, h, &noise_free)?;
-        let flip_clean = metrics::FlipImage::new(&noise_free, &at)?;
-        let clean_flip = metrics::hdr_flip_prepared(&flip_test, &flip_clean, Some(&mask))?;
-        let clean = score(&test, &noise_free, &mask, opts.lpips, &clean_flip)?;
+    if let Some(noise_free) = &noise_free {
+        let flip_clean = flip.prepare(&noise_free.linear)?;
+        let clean_flip = flip.compare(&flip_test, &flip_clean, Some(&mask))?;
+        let clean = score(&test, noise_free, &mask, opts.lpips, &clean_flip)?;
         // Both images are 0 outside the mask: the masked LPIPS is the whole frame's.
-        scores.paper = Some(whole_frame(&test, &noise_free, &clean_flip, clean.lpips)?);
+        scores.paper = Some(whole_frame(&test, noise_free, &clean_flip, clean.lpips)?);
         scores.paper_observed = Some(against_observed);
         scores.clean = Some(clean);
         if !opts.skip_ceiling {
-            let f = metrics::hdr_flip_prepared(&flip_clean, &flip_observed, Some(&mask))?;
-            scores.ceiling = Some(score(&noise_free, &observed, &mask, opts.lpips, &f)?);
+            let f = flip.compare(&flip_clean, &flip_observed, Some(&mask))?;
+            scores.ceiling = Some(score(noise_free, &observed, &mask, opts.lpips, &f)?);
         }
     } else {
         scores.paper = Some(against_observed);
     }
     if let Some(out) = out {
         let stem = format!("view{vi:03}_light{li:03}");
-        out.write_pair(&stem, (w, h), &img, &flip.map, &mask)?;
+        out.write_pair(&stem, (w, h), &img, &model_flip.map, &mask)?;
         for (name, part) in [("diffuse", &pred.diffuse), ("specular", &pred.specular)] {
             if let Some(part) = part {
                 let path = out.renders.join(format!("{stem}_{name}.png"));
@@ -331,6 +342,75 @@ impl PairSums {
             }
         }
         PairSums { model, clean, ceiling, paper, paper_observed }
+    }
+}
+
+/// The HDR-FLIP comparisons of one test image, on the window of its frame that they need.
+///
+/// Every comparison shares the observed image's exposures (a noise-free image can be black
+/// where every lit pixel faces away), so each of the (up to four) images is prepared once,
+/// whichever side of a comparison it is on. They run on a [`FlipWindow`] around the object
+/// mask and every pixel where the render or a whole-frame reference (the observation without
+/// its background, the noise-free image) is not 0: the masked means and the whole frame's maps
+/// are then the whole frame's, bit for bit (see [`metrics::flip::window`]; outside the mask a
+/// comparison with the noisy observation is not, and only its mask is read).
+struct FlipPair {
+    at: metrics::FlipExposures,
+    window: Option<FlipWindow>,
+}
+
+impl FlipPair {
+    fn new(
+        test: &Image,
+        observed: &Image,
+        mask: &[bool],
+        references: [Option<&Image>; 2],
+    ) -> Result<FlipPair> {
+        let range = metrics::flip::exposure_range(observed, Some(mask))?;
+        let ppd = metrics::flip::DEFAULT_PPD;
+        let at = metrics::FlipExposures::new(range, ppd)?;
+        // A NaN counts as not 0: its image is then cropped, and refused there.
+        let lit = |im: &Image| -> Vec<bool> {
+            im.data().chunks_exact(3).map(|c| c.iter().any(|v| *v != 0.0)).collect()
+        };
+        let mut keep = mask.to_vec();
+        for im in [Some(test)].into_iter().chain(references).flatten() {
+            keep.iter_mut().zip(lit(im)).for_each(|(k, l)| *k |= l);
+        }
+        let pixels = keep.iter().enumerate().filter(|(_, k)| **k).map(|(p, _)| p);
+        let window = FlipWindow::around((test.width(), test.height()), ppd, pixels)?
+            .filter(|w| w.pixels() < test.pixels());
+        Ok(FlipPair { at, window })
+    }
+
+    /// `image` prepared at the pair's exposures, on the window.
+    fn prepare(&self, image: &Image) -> Result<metrics::FlipImage> {
+        Ok(match &self.window {
+            Some(w) => metrics::FlipImage::new(&w.crop(image)?, &self.at)?,
+            None => metrics::FlipImage::new(image, &self.at)?,
+        })
+    }
+
+    /// HDR-FLIP of two prepared images, its mean over `mask` (of the frame) and its map in
+    /// the whole frame.
+    fn compare(
+        &self,
+        test: &metrics::FlipImage,
+        reference: &metrics::FlipImage,
+        mask: Option<&[bool]>,
+    ) -> Result<metrics::FlipResult> {
+        let Some(w) = &self.window else {
+            return Ok(metrics::hdr_flip_prepared(test, reference, mask)?);
+        };
+        let cropped = mask.map(|m| w.crop_mask(m)).transpose()?;
+        let mut result = metrics::hdr_flip_prepared(test, reference, cropped.as_deref())?;
+        result.map = w.embed(&result.map)?;
+        if mask.is_none() {
+            // The whole frame's mean, summed in its order (the zeros outside add nothing).
+            let sum: f64 = result.map.iter().map(|&v| v as f64).sum();
+            result.mean = sum / result.map.len() as f64;
+        }
+        Ok(result)
     }
 }
 

@@ -92,8 +92,15 @@ impl Separable {
     ///
     /// Both passes run a whole row at a time (tap by tap, so the inner loop vectorises over
     /// pixels) on a border-extended line; every output sums its taps in the same order as the
-    /// direct per-pixel loop, so the result is bit for bit the direct correlation.
+    /// direct per-pixel loop, so the result is bit for bit the direct correlation. Where the CPU
+    /// has AVX2 the same loops run on its wider vectors ([`stdx::simd::with_avx2`]: the same
+    /// operations, so the same bits).
     pub fn apply(&self, src: &[f32], w: usize, h: usize) -> Vec<f32> {
+        stdx::simd::with_avx2(|| self.apply_rows(src, w, h))
+    }
+
+    #[inline(always)]
+    fn apply_rows(&self, src: &[f32], w: usize, h: usize) -> Vec<f32> {
         let r = self.radius;
         let mut out = vec![0.0f32; src.len()];
         if w == 0 || h == 0 {

@@ -23,10 +23,17 @@
 //! A reference whose (masked) maximum or median luminance is 0 has no exposure range (stop would
 //! be infinite: the pitfall of black backgrounds): that is an [`Error::Exposure`] unless the
 //! exposures are given in [`FlipConfig`].
+//!
+//! **Windows.** A FLIP value depends on the inputs within a few pixels of it only, so the
+//! comparisons of an object that covers part of the frame can run on a window around it
+//! ([`window`], [`FlipWindow`]) with the whole frame's results, bit for bit.
 
 pub mod color;
 pub mod filter;
 mod ldr;
+pub mod window;
+
+pub use window::FlipWindow;
 
 use crate::error::{Error, Result};
 use crate::image::{Image, check_pair, selected};
