@@ -9,7 +9,12 @@
 //! reciprocity_pairs = 100000  # test records used for the reciprocity RMSE (0: off)
 //! lpips_weights = "..."       # default: the process's (<data root>/lpips/alex_v0.1.lpipsw)
 //! images = true               # write renders, FLIP maps and split figures
+//! probe = true                # with images: the BRDF plots' probe (`probe.bin`)
 //! ```
+//!
+//! A sweep turns off, in its ablation runs, what no table reads of them: the energy analysis
+//! and the probe (the energy table and the BRDF figures show the default options only), and the
+//! reciprocity RMSE outside the reciprocity ablation (`sweep::plan`).
 //!
 //! | key | quick | cpu | full |
 //! | --- | ---: | ---: | ---: |
@@ -62,6 +67,9 @@ pub struct EvalConfig {
     /// Write images (renders, FLIP maps, split figures).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub images: Option<bool>,
+    /// With images, evaluate the model on the BRDF plots' fixed directions (`probe.bin`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub probe: Option<bool>,
 }
 
 /// The resolved evaluation settings.
@@ -79,6 +87,8 @@ pub struct EvalSettings {
     pub lpips_weights: PathBuf,
     /// Write images.
     pub images: bool,
+    /// Write the BRDF plots' probe (only with images).
+    pub probe: bool,
 }
 
 impl EvalConfig {
@@ -104,6 +114,7 @@ impl EvalConfig {
             reciprocity_pairs: self.reciprocity_pairs.unwrap_or(recip),
             lpips_weights: self.lpips_weights.clone().unwrap_or_else(|| default_lpips.into()),
             images: self.images.unwrap_or(true),
+            probe: self.images.unwrap_or(true) && self.probe.unwrap_or(true),
         }
     }
 
@@ -147,7 +158,11 @@ mod tests {
             ..Default::default()
         };
         let r = c.resolve(Profile::Quick, here);
-        assert!(r.energy.is_none() && !r.images);
+        assert!(r.energy.is_none() && !r.images && !r.probe);
+        assert!(q.probe, "the probe follows the images by default");
+        let no_probe = EvalConfig { probe: Some(false), ..Default::default() };
+        let n = no_probe.resolve(Profile::Quick, here);
+        assert!(n.images && !n.probe);
         assert_eq!(r.lpips_weights, Path::new("mine.lpipsw"));
         let bad = EvalConfig { energy_pairs: Some(0), ..Default::default() };
         assert!(bad.validate().unwrap_err().to_string().contains("eval.energy_pairs"));

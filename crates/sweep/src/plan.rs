@@ -6,6 +6,11 @@
 //! finished run with the same id is reused, a half-finished one resumes from its checkpoint,
 //! and two profiles that share a run (the quick profile and the run-time curve) share its
 //! directory.
+//!
+//! An ablation run is evaluated for what its tables read: its image metrics, and the
+//! reciprocity RMSE in the reciprocity ablation. The energy analysis and the BRDF plots' probe
+//! are off there ([`ablation_eval`]): the energy table and the BRDF figures show the default
+//! options only.
 
 use super::profile::{Ablation, AblationModels, CaptureSource, SweepProfile, mesh_name};
 use brdf_neural::{AngleParametrization, ModelKind, Reciprocity};
@@ -183,11 +188,23 @@ pub fn runs(profile: &SweepProfile) -> Result<Vec<RunSpec>> {
             for (kind, o) in variants {
                 // The ablation's baseline is the Table 1 run of the same model.
                 push(scene, Purpose::Table, with_options(table_base, kind, d)?);
-                push(scene, Purpose::Ablation, with_options(&base, kind, o)?);
+                let config = ablation_eval(with_options(&base, kind, o)?, ablation);
+                push(scene, Purpose::Ablation, config);
             }
         }
     }
     Ok(out)
+}
+
+/// An ablation run's `[eval]`: off, what no table reads of it (the energy analysis, the BRDF
+/// plots' probe, and outside the reciprocity ablation the reciprocity RMSE).
+fn ablation_eval(mut config: RunConfig, ablation: Ablation) -> RunConfig {
+    config.eval.energy_estimator = Some(run_format::EnergyEstimator::Off);
+    config.eval.probe = Some(false);
+    if ablation != Ablation::Reciprocity {
+        config.eval.reciprocity_pairs = Some(0);
+    }
+    config
 }
 
 /// The runs of one ablation: its variants of the purely neural models `neural` (NeRFactor's of
@@ -295,6 +312,15 @@ mod tests {
         let all = default;
         let a = runs(&all).unwrap();
         assert_eq!(a.iter().filter(|r| r.scene < 3).count(), 3 * (9 + 14));
+        // The ablation runs skip what no table reads of them; the Table 1 runs keep it all.
+        for r in &a {
+            let e = &r.config.eval;
+            let ablation = r.purposes == [Purpose::Ablation];
+            let reciprocity = r.config.model.angles.reciprocity != Reciprocity::None;
+            assert_eq!(e.probe, ablation.then_some(false));
+            assert_eq!(e.energy_estimator.is_some(), ablation);
+            assert_eq!(e.reciprocity_pairs, (ablation && !reciprocity).then_some(0));
+        }
         assert!(d.iter().all(|r| a.iter().any(|x| x.config == r.config && x.scene == r.scene)));
         let runtime = SweepProfile::load("runtime").unwrap();
         let rt = runs(&runtime).unwrap();

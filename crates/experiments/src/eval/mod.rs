@@ -9,7 +9,8 @@
 //!   the scores.
 //! * [`analyses`]: energy conservation and the reciprocity RMSE on the test records.
 //! * [`probe`]: the model on the BRDF plots' fixed directions (lit sphere, slices, albedo
-//!   against angle, validity maps), stored as `<run>/probe.bin` when images are written.
+//!   against angle, validity maps), stored as `<run>/probe.bin` when images are written and
+//!   the run's `[eval] probe` is not off.
 //! * [`run_format::eval_config`]: the `[eval]` table of the run configuration.
 //!
 //! The cube-root RMSE runs over the lit test samples with theta_l, theta_v <= 80 degrees, not
@@ -224,7 +225,7 @@ pub fn evaluate(
     let energy = analyses::energy(&brdf, &data, &settings, config.seed, progress)?;
     charge(&mut phases.energy);
     let probe =
-        if settings.images { probe::probe_fitted(&brdf, dataset, &samples, &data) } else { None };
+        if settings.probe { probe::probe_fitted(&brdf, dataset, &samples, &data) } else { None };
     charge(&mut phases.probe);
     let curve = snapshot_curve(fitted, run, &all.snapshots, (&samples, &data))?;
     charge(&mut phases.curve);
