@@ -9,7 +9,7 @@
 //!
 //! An ablation run is evaluated for what its tables read: its image metrics, and the
 //! reciprocity RMSE in the reciprocity ablation. The energy analysis and the BRDF plots' probe
-//! are off there ([`ablation_eval`]): the energy table and the BRDF figures show the default
+//! are off there (`ablation_eval`): the energy table and the BRDF figures show the default
 //! options only.
 
 use super::profile::{Ablation, AblationModels, CaptureSource, SweepProfile, mesh_name};
