@@ -11,46 +11,11 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use metrics::flip::{DEFAULT_PPD, FlipWindow, exposure_range};
+use metrics::testimg::{ObjectFrame, object_frame};
 use metrics::{FlipExposures, FlipImage, Image, dssim_linear, hdr_flip_prepared};
 
-struct Frame {
-    test: Image,
-    observed: Image,
-    clean: Image,
-    mask: Vec<bool>,
-}
-
-fn frame() -> Frame {
-    let (w, h) = (128, 128);
-    let inside = |x: usize, y: usize| {
-        let (dx, dy) = (x as f32 - 60.0, y as f32 - 66.0);
-        dx * dx + dy * dy < 35.7 * 35.7
-    };
-    let shade = |x: usize, y: usize, k: f32| {
-        if inside(x, y) {
-            // A diffuse gradient and a specular highlight (the exposures span 2^4).
-            let (dx, dy) = (x as f32 - 48.0, y as f32 - 55.0);
-            let spec = 6.0 * k * (-(dx * dx + dy * dy) / 30.0).exp();
-            [0.1 + k * x as f32 / 128.0 + spec, 0.4 * k + spec, 0.05 + y as f32 / 256.0 + spec]
-        } else {
-            [0.0; 3]
-        }
-    };
-    let noise =
-        |x: usize, y: usize, c: usize| ((x * 7919 + y * 104_729 + c * 31) % 97) as f32 / 4850.0;
-    Frame {
-        test: Image::from_fn(w, h, |x, y| shade(x, y, 0.95)),
-        clean: Image::from_fn(w, h, |x, y| shade(x, y, 1.0)),
-        observed: Image::from_fn(w, h, |x, y| {
-            let s = shade(x, y, 1.0);
-            [s[0] + noise(x, y, 0), s[1] + noise(x, y, 1), s[2] + noise(x, y, 2)]
-        }),
-        mask: (0..w * h).map(|p| inside(p % w, p / w)).collect(),
-    }
-}
-
 /// The evaluation's FLIP work on one test image, on `window` (or the whole frame).
-fn flip_pair(f: &Frame, at: &FlipExposures, window: Option<&FlipWindow>) -> f64 {
+fn flip_pair(f: &ObjectFrame, at: &FlipExposures, window: Option<&FlipWindow>) -> f64 {
     let crop = |im: &Image| window.map_or_else(|| im.clone(), |w| w.crop(im).unwrap());
     let mask = window.map_or_else(|| f.mask.clone(), |w| w.crop_mask(&f.mask).unwrap());
     let prep = |im: &Image| FlipImage::new(&crop(im), at).unwrap();
@@ -74,7 +39,8 @@ fn flip_pair(f: &Frame, at: &FlipExposures, window: Option<&FlipWindow>) -> f64 
 }
 
 fn image_metrics(c: &mut Criterion) {
-    let f = frame();
+    // Spot covers 24.4 % of a default test view: a disc of radius 35.7 px in 128 x 128.
+    let f = object_frame(128, 128, (60.0, 66.0), 35.7);
     let at = FlipExposures::new(exposure_range(&f.observed, Some(&f.mask)).unwrap(), DEFAULT_PPD)
         .unwrap();
     let pixels = (0..f.mask.len()).filter(|&p| f.mask[p]);

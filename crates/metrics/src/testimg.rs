@@ -54,3 +54,43 @@ pub fn hdr_pair(w: usize, h: usize, seed: usize, gain: f64) -> (Image, Image) {
     }
     (Image::new(w, h, r).expect("size"), Image::new(w, h, t).expect("size"))
 }
+
+/// A test image of an evaluation, as [`object_frame`] makes it: an object in a frame.
+pub struct ObjectFrame {
+    /// The render of a slightly dim model: 0 outside the object.
+    pub test: Image,
+    /// The observation: the noise-free image plus noise everywhere, background included.
+    pub observed: Image,
+    /// The noise-free image: 0 outside the object.
+    pub clean: Image,
+    /// The object's pixels.
+    pub mask: Vec<bool>,
+}
+
+/// A `w` x `h` frame with a disc of `radius` pixels at `centre`, lit with a gradient and a
+/// specular highlight (the exposures span about 2^4), as an evaluation's test image sees it.
+pub fn object_frame(w: usize, h: usize, centre: (f32, f32), radius: f32) -> ObjectFrame {
+    let inside = |x: usize, y: usize| {
+        let (dx, dy) = (x as f32 - centre.0, y as f32 - centre.1);
+        dx * dx + dy * dy < radius * radius
+    };
+    let shade = |x: usize, y: usize, k: f32| {
+        if !inside(x, y) {
+            return [0.0; 3];
+        }
+        let (dx, dy) = (x as f32 - centre.0 + 0.3 * radius, y as f32 - centre.1 + 0.3 * radius);
+        let spec = 6.0 * k * (-(dx * dx + dy * dy) / 30.0).exp();
+        let (u, v) = (x as f32 / w as f32, y as f32 / h as f32);
+        [0.1 + k * u + spec, 0.4 * k + spec, 0.05 + 0.5 * v + spec]
+    };
+    let noise = |x: usize, y: usize, c: usize| 0.02 * val(x, y, c, 3) as f32;
+    ObjectFrame {
+        test: Image::from_fn(w, h, |x, y| shade(x, y, 0.95)),
+        clean: Image::from_fn(w, h, |x, y| shade(x, y, 1.0)),
+        observed: Image::from_fn(w, h, |x, y| {
+            let s = shade(x, y, 1.0);
+            [s[0] + noise(x, y, 0), s[1] + noise(x, y, 1), s[2] + noise(x, y, 2)]
+        }),
+        mask: (0..w * h).map(|p| inside(p % w, p / w)).collect(),
+    }
+}

@@ -137,6 +137,7 @@ impl FlipWindow {
 mod tests {
     use super::*;
     use crate::flip::{DEFAULT_PPD, FlipExposures, FlipImage, exposure_range, hdr_flip_prepared};
+    use crate::testimg::{ObjectFrame, object_frame};
 
     #[test]
     fn reach_is_the_csf_radius_at_the_default_ppd() {
@@ -160,26 +161,7 @@ mod tests {
     #[test]
     fn the_window_gives_the_whole_frames_flip() {
         let (w, h) = (96, 80);
-        let inside = |x: usize, y: usize| {
-            let (dx, dy) = (x as f32 - 52.0, y as f32 - 35.0);
-            dx * dx + dy * dy < 18.0 * 18.0
-        };
-        let shade = |x: usize, y: usize, k: f32| {
-            if inside(x, y) {
-                [0.2 + k * x as f32 / 96.0, 0.5 * k, 0.05 + y as f32 / 80.0]
-            } else {
-                [0.0; 3]
-            }
-        };
-        let noise =
-            |x: usize, y: usize, c: usize| ((x * 7919 + y * 104_729 + c * 31) % 97) as f32 / 970.0;
-        let clean = Image::from_fn(w, h, |x, y| shade(x, y, 1.0));
-        let test = Image::from_fn(w, h, |x, y| shade(x, y, 0.9));
-        let observed = Image::from_fn(w, h, |x, y| {
-            let s = shade(x, y, 1.0);
-            [s[0] + noise(x, y, 0), s[1] + noise(x, y, 1), s[2] + noise(x, y, 2)]
-        });
-        let mask: Vec<bool> = (0..w * h).map(|p| inside(p % w, p / w)).collect();
+        let ObjectFrame { test, observed, clean, mask } = object_frame(w, h, (52.0, 35.0), 18.0);
         let at = FlipExposures::new(exposure_range(&observed, Some(&mask)).unwrap(), DEFAULT_PPD)
             .unwrap();
         let pixels = (0..w * h).filter(|&p| mask[p]);
