@@ -55,6 +55,9 @@ pub struct RecordSet {
 /// Records a thread gathers at a time.
 const GATHER_ROWS: usize = 512;
 
+/// How many records ahead a gather asks for the rows it will read ([`stdx::prefetch`]).
+const PREFETCH_AHEAD: usize = 8;
+
 /// A gathered batch on the CPU.
 #[derive(Clone, Debug, Default)]
 pub struct CpuBatch {
@@ -169,19 +172,33 @@ impl RecordSet {
         use rayon::prelude::*;
         let (n, k) = (indices.len(), self.spatial_dim);
         // Random reads: chunks of records on every thread, first the spatial rows (most of the
-        // bytes), then the per-record fields (the same values on any thread count).
-        // Zeroed on every thread too (a single-threaded calloc costs as much as the copy).
-        let mut spatial = Vec::with_capacity(n * k);
-        spatial.par_extend(rayon::iter::repeat_n(0.0, n * k));
+        // bytes), then the per-record fields (the same values on any thread count). The rows
+        // are written into the vector's spare capacity: zeroing it first would be one more pass
+        // over the batch's largest buffer.
+        let mut spatial: Vec<f32> = Vec::with_capacity(n * k);
         if k > 0 {
-            spatial.par_chunks_mut(GATHER_ROWS * k).zip(indices.par_chunks(GATHER_ROWS)).for_each(
+            let rows = &mut spatial.spare_capacity_mut()[..n * k];
+            rows.par_chunks_mut(GATHER_ROWS * k).zip(indices.par_chunks(GATHER_ROWS)).for_each(
                 |(dst, idx)| {
-                    for (d, &i) in dst.chunks_exact_mut(k).zip(idx) {
-                        d.copy_from_slice(self.spatial_row(i));
+                    for (r, (d, &i)) in dst.chunks_exact_mut(k).zip(idx).enumerate() {
+                        // Rows are random, so each one waits on memory: ask for a later row
+                        // (and, before it, its point) while this one is copied.
+                        if let Some(&far) = idx.get(r + 2 * PREFETCH_AHEAD) {
+                            stdx::prefetch::read(&self.point[far]);
+                        }
+                        if let Some(&near) = idx.get(r + PREFETCH_AHEAD) {
+                            stdx::prefetch::slice(self.spatial_row(near));
+                        }
+                        for (o, &x) in d.iter_mut().zip(self.spatial_row(i)) {
+                            o.write(x);
+                        }
                     }
                 },
             );
         }
+        // SAFETY: the loop above wrote all n * k values: n rows (one per index, the chunks of
+        // `indices` and of the rows in step) of k values each (`spatial_row` is k long).
+        unsafe { spatial.set_len(n * k) };
         CpuBatch { spatial, ..self.gather_fields(indices) }
     }
 
@@ -214,6 +231,12 @@ impl RecordSet {
             .into_par_iter()
             .for_each(|(l, v, w, t, idx)| {
                 for (r, &i) in idx.iter().enumerate() {
+                    if let Some(&ahead) = idx.get(r + PREFETCH_AHEAD) {
+                        stdx::prefetch::read(&self.l[ahead]);
+                        stdx::prefetch::read(&self.v[ahead]);
+                        stdx::prefetch::read(&self.weight[ahead]);
+                        stdx::prefetch::read(&self.observed_gamma[ahead]);
+                    }
                     (l[r], v[r]) = (self.l[i], self.v[i]);
                     w[3 * r..3 * r + 3].copy_from_slice(&self.weight[i]);
                     t[3 * r..3 * r + 3].copy_from_slice(&self.observed_gamma[i]);

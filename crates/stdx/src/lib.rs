@@ -8,6 +8,7 @@
 //!   `rand` one (orbit cameras, sensor noise, light splits, Lanczos start blocks, Monte Carlo);
 //! - [`progress`]: the progress-bar styles of every long step;
 //! - [`simd`]: loops compiled for AVX2 where the CPU has it, with the baseline build's bits;
+//! - [`prefetch`]: software prefetches for loops of random reads (hints: no value changes);
 //! - [`cache_file`]: the versioned, checksummed container of every on-disk cache (serde values in
 //!   postcard).
 //!
@@ -22,6 +23,7 @@ pub mod fs;
 pub mod limits;
 #[cfg(feature = "fs")]
 pub mod lock;
+pub mod prefetch;
 #[cfg(feature = "progress")]
 pub mod progress;
 pub mod rng;
