@@ -101,8 +101,9 @@ impl MatRef {
 
 /// out (m x n, row-major, contiguous) = epilogue(lhs (m x k) * rhs (k x n)) with bf16
 /// operands. Every element of `out` is written (it may start uninitialised). The epilogue (a
-/// bias per column added in f32 after the sum, then a ReLU) goes into the AMX kernel's store;
-/// the other kernels apply it in one pass afterwards. `amx`: on AMX tiles where [`bf16_amx_available`] finds them,
+/// bias per column added in f32 after the sum, then a ReLU) goes into the AMX kernel's store
+/// and the AVX512-BF16 kernel's tiles of rows; the emulated path and the split-k sums apply it
+/// in one pass afterwards. `amx`: on AMX tiles where [`bf16_amx_available`] finds them,
 /// else (and everywhere without them) on the AVX512-BF16 kernel or emulated.
 ///
 /// # Safety
@@ -132,18 +133,13 @@ pub unsafe fn matmul_bf16dot(
             unsafe { crate::amx::matmul(m, n, k, lhs, rhs, out, epilogue) };
             return;
         }
+        // AVX512-BF16 applies the epilogue itself, a tile of rows at a time.
         #[cfg(target_arch = "x86_64")]
-        let native = bf16_dot_native();
-        #[cfg(not(target_arch = "x86_64"))]
-        let native = false;
-        if native {
-            #[cfg(target_arch = "x86_64")]
-            unsafe {
-                x86::matmul(m, n, k, lhs, rhs, out)
-            };
-        } else {
-            unsafe { emulated(m, n, k, lhs, rhs, core::slice::from_raw_parts_mut(out, m * n)) };
+        if bf16_dot_native() {
+            unsafe { x86::matmul(m, n, k, lhs, rhs, out, epilogue) };
+            return;
         }
+        unsafe { emulated(m, n, k, lhs, rhs, core::slice::from_raw_parts_mut(out, m * n)) };
     }
     unsafe { epilogue.apply_rows(m, n, out) };
 }
@@ -222,7 +218,7 @@ pub(crate) fn pair_bits(x0: f32, x1: f32) -> u32 {
 
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod x86 {
-    use super::{MatRef, Vec, pair_bits, vec};
+    use super::{Epilogue, MatRef, Vec, pair_bits, vec};
     use core::arch::x86_64::*;
 
     const MR: usize = 12;
@@ -249,6 +245,8 @@ pub(crate) mod x86 {
     /// gradient, summed over the batch) splits k over the threads instead of the rows.
     const SPLIT_K_MIN_K: usize = 2048;
 
+    /// The epilogue goes into each tile of rows while it is in cache ([`by_rows`]), or
+    /// follows the split-k sum.
     pub(super) unsafe fn matmul(
         m: usize,
         n: usize,
@@ -256,13 +254,15 @@ pub(crate) mod x86 {
         lhs: MatRef,
         rhs: MatRef,
         out: *mut f32,
+        epilogue: Epilogue,
     ) {
         #[cfg(feature = "rayon")]
         if k >= SPLIT_K_MIN_K && m * n <= k * 16 {
             unsafe { split_k(m, n, k, lhs, rhs, out) };
+            unsafe { epilogue.apply_rows(m, n, out) };
             return;
         }
-        unsafe { by_rows(m, n, k, lhs, rhs, out) }
+        unsafe { by_rows(m, n, k, lhs, rhs, out, epilogue) }
     }
 
     /// Pairs per k block of the split-k path: the packed blocks of both operands stay in L2.
@@ -295,6 +295,18 @@ pub(crate) mod x86 {
                     bpack.clear();
                     bpack.resize(panels * kp * NR, 0u32);
                     for q in 0..kp {
+                        // The rows PREFETCH_PAIRS pairs ahead, into L2 while this pair packs:
+                        // the weight gradient's operands (activations and upstream
+                        // gradients, megabytes each) mostly come from L3 or memory.
+                        let ahead = k0 + 2 * (q + PREFETCH_PAIRS);
+                        if ahead + 1 < k1 {
+                            unsafe {
+                                prefetch_row(lhs.at_ptr(0, ahead), m, lhs.rs);
+                                prefetch_row(lhs.at_ptr(0, ahead + 1), m, lhs.rs);
+                                prefetch_row(rhs.row(ahead), n, rhs.cs);
+                                prefetch_row(rhs.row(ahead + 1), n, rhs.cs);
+                            }
+                        }
                         unsafe {
                             pack_a_pair(m, k0 + 2 * q, k1, lhs, apack.as_mut_ptr().add(q * m));
                             pack_b_pair(n, k0 + 2 * q, k1, kp, rhs, bpack.as_mut_ptr().add(q * NR));
@@ -330,8 +342,37 @@ pub(crate) mod x86 {
         });
     }
 
-    /// Tiles of rows in parallel, the whole k in registers.
-    unsafe fn by_rows(m: usize, n: usize, k: usize, lhs: MatRef, rhs: MatRef, out: *mut f32) {
+    /// How many pairs of rows ahead the split-k packing asks for its operands' rows.
+    const PREFETCH_PAIRS: usize = 8;
+
+    /// Asks for the cache lines of `len` floats from `row` on, when they are contiguous
+    /// (`stride` 1); nothing otherwise.
+    #[inline(always)]
+    unsafe fn prefetch_row(row: *const f32, len: usize, stride: isize) {
+        if stride != 1 {
+            return;
+        }
+        let mut off = 0;
+        while off < len {
+            unsafe { _mm_prefetch::<_MM_HINT_T1>(row.add(off) as *const i8) };
+            off += 16;
+        }
+    }
+
+    /// Tiles of rows in parallel, the whole k in registers; each tile's rows get the epilogue
+    /// as soon as their last panel is stored.
+    unsafe fn by_rows(
+        m: usize,
+        n: usize,
+        k: usize,
+        lhs: MatRef,
+        rhs: MatRef,
+        out: *mut f32,
+        epilogue: Epilogue,
+    ) {
+        if let Some(b) = epilogue.bias {
+            assert_eq!(b.len(), n, "bf16dot: bias of {} values for {n} columns", b.len());
+        }
         let kp = k.div_ceil(2);
         let panels = n.div_ceil(NR);
         let tiles = m.div_ceil(MR);
@@ -349,6 +390,11 @@ pub(crate) mod x86 {
             let i0 = t * MR;
             let rows = MR.min(m - i0);
             let a = if row_contiguous {
+                // The next tile's rows, into L2 while this tile computes (a tile's products
+                // take thousands of cycles; its rows come from L3 or memory).
+                for r in i0 + MR..(i0 + 2 * MR).min(m) {
+                    unsafe { prefetch_row(lhs.row(r), k, lhs.cs) };
+                }
                 scratch.resize(rows * kp, 0);
                 for r in 0..rows {
                     unsafe { convert_row(lhs.row(i0 + r), k, scratch.as_mut_ptr().add(r * kp)) };
@@ -362,6 +408,13 @@ pub(crate) mod x86 {
                 let c = unsafe { out_ptr.get().add(i0 * n + j * NR) };
                 let b = unsafe { bpack.as_ptr().add(j * kp * NR) };
                 unsafe { kernel_dispatch(rows, kp, a, b, c, n, cols, false) };
+            }
+            if epilogue.is_some() {
+                // SAFETY: the tile's rows, which this closure alone writes.
+                let tile = unsafe {
+                    core::slice::from_raw_parts_mut(out_ptr.get().add(i0 * n), rows * n)
+                };
+                tile.chunks_exact_mut(n).for_each(|row| epilogue.apply_row(row, 0));
             }
         };
         let flops = m * n * k;
