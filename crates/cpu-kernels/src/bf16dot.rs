@@ -15,7 +15,12 @@
 //! dimension. The left operand is read as bf16 pairs (two consecutive k of one row, one u32),
 //! broadcast to all lanes; the right operand is packed into panels of 32 columns, each k pair of a
 //! column one u32 ("VNNI" layout). Row-contiguous left operands are converted a tile at a time
-//! inside the parallel loop; the others are packed once, in parallel.
+//! inside the parallel loop, the next tile's rows asked for ahead of time; the others are
+//! packed once, in parallel. A product's epilogue is added to each tile of rows as it is stored.
+//!
+//! The operands of a training step's products are megabytes that mostly come from L3 or memory,
+//! so the loops that read them ask for rows ahead (`_mm_prefetch`; what it saves:
+//! benches/README.md, "the bf16 products' operands asked for ahead of time").
 
 use crate::Epilogue;
 use alloc::vec;
@@ -411,9 +416,8 @@ pub(crate) mod x86 {
             }
             if epilogue.is_some() {
                 // SAFETY: the tile's rows, which this closure alone writes.
-                let tile = unsafe {
-                    core::slice::from_raw_parts_mut(out_ptr.get().add(i0 * n), rows * n)
-                };
+                let tile =
+                    unsafe { core::slice::from_raw_parts_mut(out_ptr.get().add(i0 * n), rows * n) };
                 tile.chunks_exact_mut(n).for_each(|row| epilogue.apply_row(row, 0));
             }
         };
