@@ -47,14 +47,18 @@ pub trait PrecisionSupport {
     /// Whether this CPU runs bf16 products natively (otherwise they are emulated, slowly).
     fn bf16_native() -> bool;
 
+    /// Whether this CPU's AVX512-BF16 kernel is faster than f32 (AMD's CPUs with it; not
+    /// Intel's, where AMX is the fast bf16 path: `cpu_kernels::bf16_dot_outpaces_f32`).
+    fn bf16_dot_outpaces_f32() -> bool;
+
     /// The precision a CPU run takes when neither its configuration nor the command line names
-    /// one: bf16 where it is faster than f32 here (AMX tiles granted, or AVX512-BF16 on a CPU
-    /// without AMX), f32 elsewhere (emulated bf16, and the AVX512-BF16 kernel on an AMX Xeon
-    /// whose tiles Linux did not grant, are slower than f32). `docs/reproduce.md` ("bf16 as the
-    /// CPU default") gives the measurements that keep bf16's converged scores within f32's
-    /// seed noise.
+    /// one: bf16 where it is faster than f32 here (AMX tiles granted, or AVX512-BF16 on an AMD
+    /// CPU), f32 elsewhere (emulated bf16, and the AVX512-BF16 kernel on an Intel CPU, whether
+    /// its AMX tiles were refused or a hypervisor hides them, are slower than f32).
+    /// `docs/reproduce.md` ("bf16 as the CPU default") gives the measurements that keep bf16's
+    /// converged scores within f32's seed noise.
     fn cpu_default() -> MatmulPrecision {
-        let faster = Self::bf16_on_amx() || (Self::bf16_native() && !Self::cpu_has_amx_bf16());
+        let faster = Self::bf16_on_amx() || Self::bf16_dot_outpaces_f32();
         if faster { MatmulPrecision::Bf16 } else { MatmulPrecision::F32 }
     }
 }
@@ -119,6 +123,17 @@ impl PrecisionSupport for MatmulPrecision {
             false
         }
     }
+
+    fn bf16_dot_outpaces_f32() -> bool {
+        #[cfg(feature = "flex")]
+        {
+            cpu_kernels::bf16_dot_outpaces_f32()
+        }
+        #[cfg(not(feature = "flex"))]
+        {
+            false
+        }
+    }
 }
 
 #[cfg(test)]
@@ -150,6 +165,24 @@ mod tests {
         }
         if MatmulPrecision::cpu_has_amx_bf16() && !MatmulPrecision::bf16_on_amx() {
             assert_eq!(d, MatmulPrecision::F32, "AVX512-BF16 on an AMX Xeon is slower than f32");
+        }
+        // The vendor as Linux reads it, against the kernels' own CPUID reading.
+        let vendor = std::fs::read_to_string("/proc/cpuinfo").ok().and_then(|info| {
+            let line = info.lines().find(|l| l.starts_with("vendor_id"))?;
+            Some(line.split(':').nth(1)?.trim().to_string())
+        });
+        if MatmulPrecision::bf16_native() && !MatmulPrecision::bf16_on_amx() {
+            match vendor.as_deref() {
+                Some("GenuineIntel") => assert_eq!(
+                    d,
+                    MatmulPrecision::F32,
+                    "AVX512-BF16 without AMX tiles on an Intel CPU is slower than f32"
+                ),
+                Some("AuthenticAMD") => {
+                    assert_eq!(d, MatmulPrecision::Bf16, "AVX512-BF16 on AMD outpaces f32")
+                }
+                _ => {}
+            }
         }
     }
 }

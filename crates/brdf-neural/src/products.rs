@@ -108,8 +108,8 @@ impl Products {
         Ok(())
     }
 
-    /// Why these products would be slower than f32 on this CPU (bf16 emulated, or the AMX
-    /// kernel off), for a warning; `None` when they are not, or on a GPU backend.
+    /// Why these products would be slower than f32 on this CPU (bf16 emulated, the AMX kernel
+    /// off, or AVX512-BF16 on an Intel CPU without AMX tiles), for a warning; `None` when they are not, or on a GPU backend.
     pub fn slow_bf16_warning(&self, backend: Backend) -> Option<&'static str> {
         if self.precision != MatmulPrecision::Bf16 || backend.is_gpu() {
             return None;
@@ -120,14 +120,21 @@ impl Products {
                  emulated, about 2x slower a step than f32 (measured on an Intel Xeon without \
                  it); f32 is the faster choice here",
             )
-        } else if MatmulPrecision::cpu_has_amx_bf16()
-            && !(self.bf16_amx && MatmulPrecision::bf16_on_amx())
-        {
+        } else if self.bf16_amx && MatmulPrecision::bf16_on_amx() {
+            None
+        } else if MatmulPrecision::cpu_has_amx_bf16() {
             Some(
                 "matmul_precision = \"bf16\" on an Intel CPU with AMX, but the AMX kernel is off \
                  (CPU_KERNELS_AMX=0, or Linux refused the tile registers): the products run on \
                  AVX512-BF16, measured 1.3x slower a step than f32 on such a Xeon \
                  (benches/README.md); f32 is likely the faster choice here",
+            )
+        } else if !MatmulPrecision::bf16_dot_outpaces_f32() {
+            Some(
+                "matmul_precision = \"bf16\" on an Intel CPU without AMX tiles (or whose \
+                 hypervisor hides them): the products run on AVX512-BF16, measured 1.3 to 1.6x \
+                 slower a step than f32 on such a Xeon (benches/README.md); f32 is likely the \
+                 faster choice here",
             )
         } else {
             None

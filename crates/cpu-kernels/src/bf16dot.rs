@@ -40,6 +40,34 @@ pub fn bf16_dot_native() -> bool {
     }
 }
 
+/// Whether this CPU's AVX512-BF16 kernel is faster than its f32 gemm: on AMD's CPUs (Zen 4
+/// on), whose `vdpbf16ps` does twice the multiply-adds of an f32 FMA at the same rate, yes; on
+/// Intel's, no: there the kernel was measured at half the f32 gemm's rate, on Xeons whose AMX
+/// tiles Linux refused and on Xeons whose hypervisor hides AMX altogether (benches/README.md,
+/// "bf16 on AMX tiles" and "Issue 56: bf16 products where a hypervisor hides AMX"). Other
+/// vendors are not assumed to gain either. `false` without AVX512-BF16.
+pub fn bf16_dot_outpaces_f32() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        bf16_dot_native() && cpu_vendor_is_amd()
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Whether CPUID's vendor string (leaf 0) is AMD's, "AuthenticAMD".
+#[cfg(target_arch = "x86_64")]
+fn cpu_vendor_is_amd() -> bool {
+    let r = core::arch::x86_64::__cpuid(0);
+    let mut vendor = [0u8; 12];
+    vendor[0..4].copy_from_slice(&r.ebx.to_le_bytes());
+    vendor[4..8].copy_from_slice(&r.edx.to_le_bytes());
+    vendor[8..12].copy_from_slice(&r.ecx.to_le_bytes());
+    &vendor == b"AuthenticAMD"
+}
+
 /// Whether bf16 products asked to take Intel's AMX tiles ([`crate::Precision::Bf16`] with
 /// `amx`) run on them in this process: the CPU has AMX-TILE and AMX-BF16 and Linux granted the
 /// tile registers ([`crate::amx`]).

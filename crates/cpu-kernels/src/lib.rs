@@ -32,7 +32,10 @@ pub mod epilogue;
 pub mod gemm_f32;
 pub mod split_k;
 
-pub use bf16dot::{MatRef, bf16_amx_available, bf16_dot_native, emulated_row_major, round_to_bf16};
+pub use bf16dot::{
+    MatRef, bf16_amx_available, bf16_dot_native, bf16_dot_outpaces_f32, emulated_row_major,
+    round_to_bf16,
+};
 pub use epilogue::Epilogue;
 
 /// The precision of an f32 matrix product.

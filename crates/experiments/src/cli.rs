@@ -80,6 +80,10 @@ pub fn cpu_default_precision() -> (MatmulPrecision, &'static str) {
         _ if MatmulPrecision::cpu_has_amx_bf16() => {
             "this CPU has AMX, but Linux did not grant its tiles to this process"
         }
+        _ if MatmulPrecision::bf16_native() => {
+            "this CPU's AVX512-BF16 products are slower than f32 (an Intel CPU without AMX \
+             tiles, or with AMX hidden by a hypervisor)"
+        }
         _ => "this CPU has no native bf16 products",
     };
     (p, why)
