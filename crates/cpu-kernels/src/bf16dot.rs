@@ -42,10 +42,11 @@ pub fn bf16_dot_native() -> bool {
 
 /// Whether this CPU's AVX512-BF16 kernel is faster than its f32 gemm: on AMD's CPUs (Zen 4
 /// on), whose `vdpbf16ps` does twice the multiply-adds of an f32 FMA at the same rate, yes; on
-/// Intel's, no: there the kernel was measured at half the f32 gemm's rate, on Xeons whose AMX
-/// tiles Linux refused and on Xeons whose hypervisor hides AMX altogether (benches/README.md,
-/// "bf16 on AMX tiles" and "Issue 56: bf16 products where a hypervisor hides AMX"). Other
-/// vendors are not assumed to gain either. `false` without AVX512-BF16.
+/// Intel's, no: there `vdpbf16ps` issues at a quarter of the FMA's rate, and the kernel was
+/// measured at about half the f32 gemm's rate, on Xeons whose AMX tiles Linux refused and on
+/// Xeons whose hypervisor hides AMX altogether (benches/README.md, "bf16 on AMX tiles" and
+/// "Issue 56: bf16 products where a hypervisor hides AMX"; `examples/instruction_rates.rs`
+/// measures a CPU). Other vendors are not assumed to gain either. `false` without AVX512-BF16.
 pub fn bf16_dot_outpaces_f32() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
