@@ -132,7 +132,7 @@ impl Products {
         } else if !MatmulPrecision::bf16_dot_outpaces_f32() {
             Some(
                 "matmul_precision = \"bf16\" on an Intel CPU without AMX tiles (or whose \
-                 hypervisor hides them): the products run on AVX512-BF16, measured 1.3 to 1.6x \
+                 hypervisor hides them): the products run on AVX512-BF16, measured 1.3 to 1.8x \
                  slower a step than f32 on such a Xeon (benches/README.md); f32 is likely the \
                  faster choice here",
             )
