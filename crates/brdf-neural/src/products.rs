@@ -109,7 +109,8 @@ impl Products {
     }
 
     /// Why these products would be slower than f32 on this CPU (bf16 emulated, the AMX kernel
-    /// off, or AVX512-BF16 on an Intel CPU without AMX tiles), for a warning; `None` when they are not, or on a GPU backend.
+    /// off, or AVX512-BF16 on an Intel CPU without AMX tiles), for a warning; `None` when they
+    /// are not, or on a GPU backend.
     pub fn slow_bf16_warning(&self, backend: Backend) -> Option<&'static str> {
         if self.precision != MatmulPrecision::Bf16 || backend.is_gpu() {
             return None;
