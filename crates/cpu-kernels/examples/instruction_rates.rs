@@ -1,6 +1,7 @@
-//! The peak rates of the two instructions the CPU kernels' products are built on, on one core:
-//! the f32 FMA (`vfmadd231ps` on zmm, what the f32 gemm runs) and the bf16 dot product
-//! (`vdpbf16ps` on zmm, the AVX512-BF16 kernel's). Each issues 16 independent accumulator
+//! The peak rates of the instructions the CPU kernels' products are built on, on one core: the
+//! f32 FMA (`vfmadd231ps` on zmm, what the f32 gemm runs), the binary16 FMA (`vfmadd231ph`, the
+//! f16 kernel's, where the CPU has AVX512-FP16) and the bf16 dot product (`vdpbf16ps` on zmm,
+//! the AVX512-BF16 kernel's). Each issues 16 independent accumulator
 //! chains in a loop, so the figure is the instruction's throughput, not its latency.
 //!
 //! Whether bf16 products pay on a CPU without AMX comes down to the ratio printed last: a
@@ -28,6 +29,31 @@ mod x86 {
             unsafe { core::arch::asm!("", options(nomem, nostack)) };
         }
         _mm512_reduce_add_ps(acc.iter().fold(_mm512_setzero_ps(), |s, x| _mm512_add_ps(s, *x)))
+    }
+
+    /// `iters` rounds of 16 independent `vfmadd231ph` zmm (binary16, inline assembly: Rust
+    /// has no stable binary16 intrinsics).
+    #[target_feature(enable = "avx512f,avx512bw,avx512vl,avx512fp16")]
+    pub unsafe fn fma_f16(iters: u64) -> f32 {
+        let mut acc = [_mm512_setzero_si512(); 16];
+        // binary16 bits of 1.0 and 0.5 in every lane.
+        let (a, b) = (_mm512_set1_epi16(0x3c00), _mm512_set1_epi16(0x3800));
+        for _ in 0..iters {
+            for x in acc.iter_mut() {
+                // SAFETY: register operands only; AVX512-FP16 is enabled for this function.
+                unsafe {
+                    core::arch::asm!(
+                        "vfmadd231ph {x}, {a}, {b}",
+                        x = inout(zmm_reg) *x,
+                        a = in(zmm_reg) a,
+                        b = in(zmm_reg) b,
+                        options(pure, nomem, nostack),
+                    )
+                };
+            }
+        }
+        let sum = acc.iter().fold(_mm512_setzero_si512(), |s, x| _mm512_xor_si512(s, *x));
+        _mm512_reduce_add_epi32(sum) as f32
     }
 
     /// `iters` rounds of 16 independent `vdpbf16ps` zmm.
@@ -73,6 +99,17 @@ fn main() {
             fma / 1e9,
             fma * 32.0 / 1e9
         );
+        if cpu_kernels::f16dot::f16_native() {
+            // SAFETY: AVX512-FP16 (with F, BW and VL) was detected by `f16_native`.
+            let ph = rate(|n| unsafe { x86::fma_f16(n) }, iters);
+            println!(
+                "binary16 FMA (zmm): {:.2} G/s, {:.1} GFLOP/s on one core; binary16 / f32 \
+                 multiply-add rate {:.2}x",
+                ph / 1e9,
+                ph * 64.0 / 1e9,
+                ph * 2.0 / fma
+            );
+        }
         if !cpu_kernels::bf16_dot_native() {
             println!("no AVX512-BF16 on this CPU: bf16 products are emulated");
             return;

@@ -9,6 +9,7 @@
 //! | path | when | module |
 //! | --- | --- | --- |
 //! | bf16 operands, f32 sums (AMX tiles, else `vdpbf16ps`, else emulated) | [`Precision::Bf16`] (`amx`), n >= 16, k >= 8, m n k >= 2^18 | [`bf16dot`], [`amx`] |
+//! | scaled binary16 operands, binary16 sums over runs of 64 k, f32 over runs (`vfmadd231ph`, else emulated) | [`Precision::F16`], the same sizes, except a long k into a small output (weight gradients stay f32) | [`f16dot`] |
 //! | f32, k summed in blocks in parallel | a long k (>= 8,192) into a small output (<= 256 x 256): weight gradients | [`split_k`] |
 //! | f32 gemm in blocks of rows on every thread, the epilogue applied while the block is in cache | an epilogue, or at least two blocks of rows (2,048 rows at 128 columns); n >= 16 | [`gemm_f32`] |
 //! | f32 gemm (the `gemm` crate, as burn-flex calls it) | everything else | [`gemm_f32`] |
@@ -29,6 +30,9 @@ pub mod amx;
 pub mod bf16dot;
 pub mod elementwise;
 pub mod epilogue;
+pub mod f16dot;
+#[cfg(target_arch = "x86_64")]
+mod f16dot_x86;
 pub mod gemm_f32;
 pub mod split_k;
 
@@ -52,9 +56,17 @@ pub enum Precision {
         /// Take the AMX tiles where they are available.
         amx: bool,
     },
+    /// Operands scaled by powers of two and rounded to binary16, products summed in binary16
+    /// over runs of [`f16dot::RUN`] k, the runs in f32 ([`f16dot`]): on AVX512-FP16, twice the
+    /// multiply-adds of f32 per instruction; emulated elsewhere. Products that [`f16dot::parts`]
+    /// would split over k (weight gradients) stay f32: their operands' scaling and conversion,
+    /// two more passes over megabytes, cost more than the faster products save
+    /// (`examples/product_rates.rs`).
+    F16,
 }
 
-/// Whether an m x k by k x n product in [`Precision::Bf16`] takes the bf16 kernels: products
+/// Whether an m x k by k x n product in [`Precision::Bf16`] (or [`Precision::F16`]) takes the
+/// bf16 (f16) kernels: products
 /// that gain nothing (narrow outputs such as a 3-channel head, a short k, small products) stay
 /// f32.
 pub fn takes_bf16(m: usize, n: usize, k: usize) -> bool {
@@ -93,6 +105,12 @@ pub unsafe fn matmul(
     {
         // SAFETY: the caller's contract, which is the kernel's.
         unsafe { bf16dot::matmul_bf16dot(m, n, k, lhs, rhs, out, epilogue, amx) };
+        return;
+    }
+    // The f16 path where it gains: not the split-k products (see `Precision::F16`).
+    if precision == Precision::F16 && takes_bf16(m, n, k) && f16dot::parts(m, n, k).0 == 1 {
+        // SAFETY: the caller's contract, which is the kernel's.
+        unsafe { f16dot::matmul_f16(m, n, k, lhs, rhs, out, epilogue) };
         return;
     }
     let blocks = split_k::split_k_blocks(m, n, k);
