@@ -245,11 +245,12 @@ struct ReproduceArgs {
     /// `--features wgpu` or `cuda`). On a GPU, use `--jobs 1`.
     #[arg(long, default_value = "cpu", value_parser = parse_backend)]
     backend: Backend,
-    /// Precision of the training steps' matrix products, for every run: `f32` or `bf16`
-    /// (CPU backend; about 1.5x faster fits on AVX512-BF16 CPUs, see docs/guide.md). Without it,
-    /// the profile's `run.train.matmul_precision` holds where it names one; otherwise, on the
-    /// CPU, bf16 where this CPU runs it natively and faster (AMX tiles, or AVX512-BF16
-    /// without AMX) and f32 elsewhere, printed at the start. bf16 runs get their own run ids.
+    /// Precision of the training steps' matrix products, for every run: `f32`, `bf16` or `f16`
+    /// (CPU backend; see docs/guide.md for their speeds). Without it, the profile's
+    /// `run.train.matmul_precision` holds where it names one; otherwise, on the CPU, bf16 where
+    /// this CPU runs it natively and faster (AMX tiles, or AVX512-BF16 on AMD), else f16 where
+    /// it runs binary16 natively (AVX512-FP16), else f32, printed at the start. bf16 and f16
+    /// runs get their own run ids.
     #[arg(long, value_parser = parse_precision)]
     matmul_precision: Option<MatmulPrecision>,
     /// Only the runs of these tables of the paper, comma-separated: table1, energy, nol,
@@ -346,12 +347,13 @@ impl SlurmArgs {
     }
 }
 
-/// `--matmul-precision`: `f32` or `bf16`.
+/// `--matmul-precision`: `f32`, `bf16` or `f16`.
 fn parse_precision(name: &str) -> std::result::Result<MatmulPrecision, String> {
     match name {
         "f32" => Ok(MatmulPrecision::F32),
         "bf16" => Ok(MatmulPrecision::Bf16),
-        other => Err(format!("unknown precision {other:?} (f32, bf16)")),
+        "f16" => Ok(MatmulPrecision::F16),
+        other => Err(format!("unknown precision {other:?} (f32, bf16, f16)")),
     }
 }
 

@@ -56,8 +56,10 @@ pub fn reproduce(opts: Options) -> Result<()> {
         opts.backend
     );
     anyhow::ensure!(
-        opts.matmul_precision != Some(MatmulPrecision::Bf16) || opts.backend == Backend::Flex,
-        "--matmul-precision bf16 is implemented for the CPU backend only, not --backend {}",
+        opts.matmul_precision.is_none_or(|p| p == MatmulPrecision::F32)
+            || opts.backend == Backend::Flex,
+        "--matmul-precision {} is implemented for the CPU backend only, not --backend {}",
+        opts.matmul_precision.unwrap_or_default().name(),
         opts.backend
     );
     let mut profile = with_precision(SweepProfile::load(&opts.profile)?, &opts);
@@ -132,8 +134,8 @@ fn with_precision(profile: SweepProfile, opts: &Options) -> SweepProfile {
     }
     let (precision, why) = experiments::cli::cpu_default_precision();
     eprintln!(
-        "matmul precision {}: {why} (`--matmul-precision f32` or `bf16` chooses; bf16 runs have \
-         their own run ids)",
+        "matmul precision {}: {why} (`--matmul-precision f32`, `bf16` or `f16` chooses; bf16 and \
+         f16 runs have their own run ids)",
         precision.name()
     );
     profile.with_matmul_precision(precision)

@@ -83,6 +83,10 @@ fn precisions() -> Vec<(&'static str, Products)> {
                 out.push(("bf16", p.with_bf16_amx(true)));
             }
             "bf16" => eprintln!("bf16: not native on this CPU, skipped"),
+            "f16" if MatmulPrecision::f16_native() => {
+                out.push(("f16", Products { precision: MatmulPrecision::F16, ..Products::F32 }))
+            }
+            "f16" => eprintln!("f16: not native on this CPU, skipped"),
             other => panic!("BRDF_BENCH_PRECISION: unknown precision {other:?}"),
         }
     }

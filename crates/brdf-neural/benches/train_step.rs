@@ -490,7 +490,8 @@ fn precisions() -> Vec<MatmulPrecision> {
         .map(|p| match p.trim() {
             "f32" => MatmulPrecision::F32,
             "bf16" => MatmulPrecision::Bf16,
-            other => panic!("BRDF_BENCH_PRECISION: unknown precision {other:?} (f32, bf16)"),
+            "f16" => MatmulPrecision::F16,
+            other => panic!("BRDF_BENCH_PRECISION: unknown precision {other:?} (f32, bf16, f16)"),
         })
         .collect()
 }

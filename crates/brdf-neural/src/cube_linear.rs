@@ -41,6 +41,8 @@ fn kernel_precision(client: &cubecl::prelude::Client, p: MatmulPrecision) -> Pre
             });
             Precision::F32
         }
+        // Refused before a GPU batch is built (`PrecisionSupport::check`).
+        MatmulPrecision::F16 => Precision::F32,
     }
 }
 

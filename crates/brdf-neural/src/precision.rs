@@ -1,4 +1,5 @@
-//! Precision of the f32 matrix products in training: plain f32, or bf16 dot products.
+//! Precision of the f32 matrix products in training: plain f32, bf16 dot products, or scaled
+//! binary16 multiply-adds.
 //!
 //! [`MatmulPrecision::Bf16`] is the CPU counterpart of PyTorch's
 //! `torch.set_float32_matmul_precision("medium")`: the operands of the network's large matrix
@@ -9,6 +10,14 @@
 //! slower than f32. On an NVIDIA GPU (`--backend cuda`, Ampere or later) the products run on
 //! tensor cores (`gpu-kernels`' `gemm_cmma`), PyTorch's bf16 autocast for the linear layers.
 //! The flex and cuda backends implement it; the others refuse it.
+//!
+//! [`MatmulPrecision::F16`] is for Intel CPUs whose bf16 is slow (AVX512-BF16 without AMX
+//! tiles) but which run AVX512-FP16's `vfmadd231ph`: twice f32's multiply-adds per
+//! instruction. The operands are scaled by powers of two per row and column and rounded to
+//! binary16 (11 significant bits), the products summed in binary16 over runs of 64 and the
+//! runs in f32 (`cpu_kernels::f16dot` defines the value to the bit and emulates it on other
+//! CPUs). The forward and input-gradient products take it; the weight gradients stay f32. The
+//! flex backend alone implements it.
 //!
 //! The precision is part of a batch's [`crate::products::Products`], with the choice of the
 //! bf16 kernel (AMX tiles where available, or AVX512-BF16): a training loop's step
@@ -51,6 +60,10 @@ pub trait PrecisionSupport {
     /// Intel's, where AMX is the fast bf16 path: `cpu_kernels::bf16_dot_outpaces_f32`).
     fn bf16_dot_outpaces_f32() -> bool;
 
+    /// Whether this CPU runs [`MatmulPrecision::F16`]'s binary16 multiply-adds natively
+    /// (AVX512-FP16: Intel's Xeons from Sapphire Rapids on); otherwise they are emulated.
+    fn f16_native() -> bool;
+
     /// The precision a CPU run takes when neither its configuration nor the command line names
     /// one: bf16 where it is faster than f32 here (AMX tiles granted, or AVX512-BF16 on an AMD
     /// CPU), f32 elsewhere (emulated bf16, and the AVX512-BF16 kernel on an Intel CPU, whether
@@ -58,8 +71,13 @@ pub trait PrecisionSupport {
     /// `docs/reproduce.md` ("bf16 as the CPU default") gives the measurements that keep bf16's
     /// converged scores within f32's seed noise.
     fn cpu_default() -> MatmulPrecision {
-        let faster = Self::bf16_on_amx() || Self::bf16_dot_outpaces_f32();
-        if faster { MatmulPrecision::Bf16 } else { MatmulPrecision::F32 }
+        if Self::bf16_on_amx() || Self::bf16_dot_outpaces_f32() {
+            MatmulPrecision::Bf16
+        } else if Self::f16_native() {
+            MatmulPrecision::F16
+        } else {
+            MatmulPrecision::F32
+        }
     }
 }
 
@@ -68,6 +86,13 @@ impl PrecisionSupport for MatmulPrecision {
         use crate::device::Backend;
         if self == MatmulPrecision::F32 {
             return Ok(());
+        }
+        if self == MatmulPrecision::F16 && backend != Backend::Flex {
+            let why = format!(
+                "matmul precision f16 is implemented for the flex CPU backend only (AVX512-FP16),                  not {}: use bf16 on a GPU",
+                backend.name()
+            );
+            return Err(model_spec::Error::InvalidConfig(why).into());
         }
         let refused = match backend {
             Backend::Flex => None,
@@ -134,6 +159,17 @@ impl PrecisionSupport for MatmulPrecision {
             false
         }
     }
+
+    fn f16_native() -> bool {
+        #[cfg(feature = "flex")]
+        {
+            cpu_kernels::f16dot::f16_native()
+        }
+        #[cfg(not(feature = "flex"))]
+        {
+            false
+        }
+    }
 }
 
 #[cfg(test)]
@@ -153,7 +189,8 @@ mod tests {
         assert_eq!(MatmulPrecision::cpu_has_amx_bf16(), kernel, "{flags}");
     }
 
-    /// The CPU default is bf16 exactly where bf16 runs natively and faster than f32.
+    /// The CPU default is bf16 exactly where bf16 runs natively and faster than f32, else f16
+    /// where AVX512-FP16 runs it, else f32.
     #[test]
     fn the_cpu_default_is_bf16_only_where_it_is_native_and_faster() {
         let d = MatmulPrecision::cpu_default();
@@ -162,6 +199,9 @@ mod tests {
         }
         if MatmulPrecision::bf16_on_amx() {
             assert_eq!(d, MatmulPrecision::Bf16);
+        }
+        if d == MatmulPrecision::F16 {
+            assert!(MatmulPrecision::f16_native(), "emulated f16 is slower than f32");
         }
         if MatmulPrecision::cpu_has_amx_bf16() && !MatmulPrecision::bf16_on_amx() {
             assert_eq!(d, MatmulPrecision::F32, "AVX512-BF16 on an AMX Xeon is slower than f32");
@@ -173,9 +213,9 @@ mod tests {
         });
         if MatmulPrecision::bf16_native() && !MatmulPrecision::bf16_on_amx() {
             match vendor.as_deref() {
-                Some("GenuineIntel") => assert_eq!(
+                Some("GenuineIntel") => assert_ne!(
                     d,
-                    MatmulPrecision::F32,
+                    MatmulPrecision::Bf16,
                     "AVX512-BF16 without AMX tiles on an Intel CPU is slower than f32"
                 ),
                 Some("AuthenticAMD") => {

@@ -112,7 +112,17 @@ impl Products {
     /// off, or AVX512-BF16 on an Intel CPU without AMX tiles), for a warning; `None` when they
     /// are not, or on a GPU backend.
     pub fn slow_bf16_warning(&self, backend: Backend) -> Option<&'static str> {
-        if self.precision != MatmulPrecision::Bf16 || backend.is_gpu() {
+        if backend.is_gpu() {
+            return None;
+        }
+        if self.precision == MatmulPrecision::F16 {
+            return (!MatmulPrecision::f16_native()).then_some(
+                "matmul_precision = \"f16\" on a CPU without AVX512-FP16: the products are \
+                 emulated one multiply-add at a time, many times slower than f32; f32 (or bf16 \
+                 where native) is the faster choice here",
+            );
+        }
+        if self.precision != MatmulPrecision::Bf16 {
             return None;
         }
         if !MatmulPrecision::bf16_native() {

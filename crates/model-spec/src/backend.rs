@@ -70,6 +70,9 @@ pub enum MatmulPrecision {
     F32,
     /// Operands rounded to bf16, products summed in f32.
     Bf16,
+    /// Operands scaled by powers of two and rounded to binary16, products summed in binary16
+    /// over runs of 32, the runs in f32 (the CPU's AVX512-FP16; `cpu_kernels::f16dot`).
+    F16,
 }
 
 impl MatmulPrecision {
@@ -78,6 +81,7 @@ impl MatmulPrecision {
         match self {
             MatmulPrecision::F32 => "f32",
             MatmulPrecision::Bf16 => "bf16",
+            MatmulPrecision::F16 => "f16",
         }
     }
 }

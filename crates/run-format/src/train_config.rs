@@ -71,8 +71,10 @@
 //! PyTorch's 1e-8 (burn's own default, 1e-5, damps every update whose gradient is that small).
 //! `matmul_precision = "bf16"` trains with the network's large matrix products on bf16 operands
 //! and f32 sums (brdf-neural's `precision`: flex on the CPU, cuda on tensor cores; evaluation
-//! stays f32);
-//! `docs/reproduce.md` gives its measured speed and what it does to the converged scores.
+//! stays f32); `"f16"` on binary16 operands scaled per row and column, summed in binary16 over
+//! runs of 64 and in f32 over runs (flex only, native with AVX512-FP16; the weight gradients
+//! stay f32). `docs/reproduce.md` gives their measured speed and what they do to the converged
+//! scores.
 
 use crate::{Error, Result};
 use model_spec::MatmulPrecision;

@@ -106,8 +106,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let precision = match std::env::var("PROFILE_PRECISION").as_deref() {
         Ok("f32") => Some(brdf_neural::precision::MatmulPrecision::F32),
         Ok("bf16") => Some(brdf_neural::precision::MatmulPrecision::Bf16),
+        Ok("f16") => Some(brdf_neural::precision::MatmulPrecision::F16),
         Ok(other) => {
-            return Err(format!("PROFILE_PRECISION={other:?}: expected f32 or bf16").into());
+            return Err(format!("PROFILE_PRECISION={other:?}: expected f32, bf16 or f16").into());
         }
         Err(_) => None,
     };

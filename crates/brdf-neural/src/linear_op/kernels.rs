@@ -27,6 +27,7 @@ fn kernel_precision(p: Products) -> cpu_kernels::Precision {
     match p.precision {
         MatmulPrecision::F32 => cpu_kernels::Precision::F32,
         MatmulPrecision::Bf16 => cpu_kernels::Precision::Bf16 { amx: p.bf16_amx },
+        MatmulPrecision::F16 => cpu_kernels::Precision::F16,
     }
 }
 
