@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Trains benches/profiles/bit_identity.toml (all nine kinds, 40 steps at batch 8,192) in f32 and
-# in bf16 with the given xtask binary and prints one SHA-256 per run of its weights
+# Trains benches/profiles/bit_identity.toml (all nine kinds, 40 steps at batch 8,192) in f32, in
+# bf16 and, where the CPU has AVX512-FP16 (f16 is emulated, far too slowly, elsewhere), in f16
+# with the given xtask binary and prints one SHA-256 per run of its weights
 # (model.safetensors) and its training log (losses), sorted: two builds train bit-identically
 # when their outputs are equal. Usage:
 #   bash benches/bit_identity.sh target/release/xtask out/bits-before > before.txt
@@ -12,7 +13,11 @@ exe=${1:?xtask binary}
 out=${2:?output folder}
 here=$(cd "$(dirname "$0")" && pwd)
 mkdir -p "$out"
-for precision in f32 bf16; do
+precisions="f32 bf16"
+if grep -qw avx512_fp16 /proc/cpuinfo 2>/dev/null; then
+    precisions="$precisions f16"
+fi
+for precision in $precisions; do
     profile="$out/bit_identity_$precision.toml"
     sed "s/^matmul_precision = .*/matmul_precision = \"$precision\"/" \
         "$here/profiles/bit_identity.toml" >"$profile"
