@@ -66,10 +66,11 @@ pub trait PrecisionSupport {
 
     /// The precision a CPU run takes when neither its configuration nor the command line names
     /// one: bf16 where it is faster than f32 here (AMX tiles granted, or AVX512-BF16 on an AMD
-    /// CPU), f32 elsewhere (emulated bf16, and the AVX512-BF16 kernel on an Intel CPU, whether
-    /// its AMX tiles were refused or a hypervisor hides them, are slower than f32).
-    /// `docs/reproduce.md` ("bf16 as the CPU default") gives the measurements that keep bf16's
-    /// converged scores within f32's seed noise.
+    /// CPU); else f16 where AVX512-FP16 runs it (an Intel CPU whose AMX tiles were refused or
+    /// are hidden by a hypervisor: its AVX512-BF16 kernel is slower than f32, its binary16
+    /// products faster); else f32. `docs/reproduce.md` ("bf16 as the CPU default", "f16 where
+    /// bf16 is slow") gives the measurements that keep their converged scores within f32's seed
+    /// noise.
     fn cpu_default() -> MatmulPrecision {
         if Self::bf16_on_amx() || Self::bf16_dot_outpaces_f32() {
             MatmulPrecision::Bf16

@@ -11,7 +11,7 @@
 //! 2. Within a part, row i of the left operand is scaled by 2^ea_i and column j of the right by
 //!    2^eb_j, the powers of two that put each one's largest magnitude in [8, 16)
 //!    ([`scale_exp`]), then rounded to binary16 (to nearest, ties to even). Every product of two
-//!    such values is below 256 in magnitude, every sum of [`RUN`] of them below 2^14, well
+//!    such values is at most 256 in magnitude, every sum of [`RUN`] of them about 2^14 at most, well
 //!    within binary16's 65,504; a power of two changes no bits of a significand.
 //! 3. The part's k are taken in runs of [`RUN`] from its start: each run's products are summed
 //!    in binary16 by fused multiply-adds in k order from +0, and the runs' sums are added in f32

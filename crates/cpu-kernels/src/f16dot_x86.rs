@@ -9,6 +9,7 @@
 //! row-major operand, the forward and input-gradient products) or k-major, the tile's 12 values
 //! of one k side by side (a k-major operand, the weight gradient's activations).
 
+use crate::bf16dot::x86::SendPtr;
 use crate::f16dot::{RUN, parts, pow2, scale_exp};
 use crate::{Epilogue, MatRef};
 use alloc::vec;
@@ -20,15 +21,6 @@ const MR: usize = 12;
 const NR: usize = 32;
 /// k per row block of the row-major tile layout (its row stride, a multiple of [`RUN`]).
 const KB: usize = 256;
-
-struct SendPtr<T>(*mut T);
-unsafe impl<T> Send for SendPtr<T> {}
-unsafe impl<T> Sync for SendPtr<T> {}
-impl<T> SendPtr<T> {
-    fn get(&self) -> *mut T {
-        self.0
-    }
-}
 
 /// How a packed tile of the left operand is laid out.
 #[derive(Clone, Copy, PartialEq)]
