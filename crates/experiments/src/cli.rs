@@ -79,7 +79,7 @@ pub fn cpu_default_precision() -> (MatmulPrecision, &'static str) {
         MatmulPrecision::Bf16 => "this CPU runs bf16 products natively (AVX512-BF16)",
         MatmulPrecision::F16 => {
             "this CPU's bf16 products are slower than f32 (AVX512-BF16 without AMX tiles), its \
-             binary16 multiply-adds twice as fast (AVX512-FP16)"
+             scaled binary16 products faster (AVX512-FP16)"
         }
         _ if MatmulPrecision::cpu_has_amx_bf16() => {
             "this CPU has AMX, but Linux did not grant its tiles to this process"
